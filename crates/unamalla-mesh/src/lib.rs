@@ -1,0 +1,26 @@
+//! # unamalla-mesh
+//!
+//! The foundation of the unamalla crate family: geometry primitives, validated polygonal
+//! regions with holes, structured and unstructured quad/hex meshes, **the mesh traits every
+//! other crate is written against**, transfinite interpolation and quality metrics.
+//!
+//! Conventions (also in `docs/conventions.md`):
+//! * coordinates are `f64`; points are [`glam::DVec2`] / [`glam::DVec3`] (re-exported here);
+//! * regions: outer ring counter-clockwise, holes clockwise, rings stored open;
+//! * structured 2D grid node `(i, j)`, `i` along the bottom side, `j` upward; cells
+//!   counter-clockwise `(i,j), (i+1,j), (i+1,j+1), (i,j+1)`;
+//! * α (triangle measure) is the doubled signed area `det(Q − P, R − P)`.
+
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod grid;
+pub mod quality;
+pub mod traits;
+pub mod unstructured;
+
+pub use error::{GeometryError, MeshError, RingId};
+pub use glam::{DVec2, DVec3};
+pub use grid::{StructuredGrid2, StructuredGrid3};
+pub use traits::{FreeNodes, HasHexCells, HasNodes, HasQuadCells};
+pub use unstructured::{HexMesh, QuadMesh, HEX_FACES};

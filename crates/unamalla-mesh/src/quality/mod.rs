@@ -1,0 +1,1 @@
+//! Quality metrics of quad and hex cells and whole meshes.
