@@ -314,8 +314,9 @@ mod tests {
 
     #[test]
     fn grid3_hex_order_is_vtk() {
-        let g = StructuredGrid3::from_fn(3, 3, 3, |i, j, k| DVec3::new(i as f64, j as f64, k as f64))
-            .unwrap();
+        let g =
+            StructuredGrid3::from_fn(3, 3, 3, |i, j, k| DVec3::new(i as f64, j as f64, k as f64))
+                .unwrap();
         let h = g.hex_points(g.num_hexes() - 1);
         assert_eq!(h[0], DVec3::new(1.0, 1.0, 1.0));
         assert_eq!(h[1], DVec3::new(2.0, 1.0, 1.0));

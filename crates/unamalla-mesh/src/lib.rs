@@ -14,13 +14,24 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod geometry;
 pub mod grid;
 pub mod quality;
+pub mod refine;
+pub mod region;
+pub mod resample;
+pub mod spatial;
+pub mod tfi;
 pub mod traits;
 pub mod unstructured;
 
 pub use error::{GeometryError, MeshError, RingId};
+pub use geometry::Location;
 pub use glam::{DVec2, DVec3};
 pub use grid::{StructuredGrid2, StructuredGrid3};
+pub use region::{Polygon, Region};
+pub use resample::resample_arc_length;
+pub use spatial::{EdgeRef, SegmentIndex};
+pub use tfi::{tfi2, tfi3, HexFaces, TfiParams};
 pub use traits::{FreeNodes, HasHexCells, HasNodes, HasQuadCells};
 pub use unstructured::{HexMesh, QuadMesh, HEX_FACES};

@@ -253,7 +253,8 @@ mod tests {
 
     #[test]
     fn quad_mesh_from_grid_matches_boundary_detection() {
-        let g = StructuredGrid2::from_fn(5, 4, |i, j| DVec2::new(i as f64, (j * j) as f64)).unwrap();
+        let g =
+            StructuredGrid2::from_fn(5, 4, |i, j| DVec2::new(i as f64, (j * j) as f64)).unwrap();
         let q = QuadMesh::from_grid(&g);
         assert_eq!(q.fixed(), q.boundary_flags().as_slice());
         assert_eq!(q.num_free(), 3 * 2);
@@ -261,8 +262,9 @@ mod tests {
 
     #[test]
     fn hex_mesh_boundary_flags_match_grid() {
-        let g = StructuredGrid3::from_fn(4, 3, 5, |i, j, k| DVec3::new(i as f64, j as f64, k as f64))
-            .unwrap();
+        let g =
+            StructuredGrid3::from_fn(4, 3, 5, |i, j, k| DVec3::new(i as f64, j as f64, k as f64))
+                .unwrap();
         let h = HexMesh::from_grid(&g);
         let rebuilt = HexMesh::new(h.nodes().to_vec(), h.cells().to_vec()).unwrap();
         assert_eq!(rebuilt.fixed(), h.fixed());
