@@ -21,6 +21,7 @@ pub mod refine;
 pub mod region;
 pub mod resample;
 pub mod spatial;
+pub mod svg;
 pub mod tfi;
 pub mod traits;
 pub mod unstructured;
