@@ -13,6 +13,7 @@
 
 #![warn(missing_docs)]
 
+pub mod block;
 pub mod error;
 pub mod geometry;
 pub mod grid;
@@ -26,6 +27,7 @@ pub mod tfi;
 pub mod traits;
 pub mod unstructured;
 
+pub use block::BlockMesh2;
 pub use error::{GeometryError, MeshError, RingId};
 pub use geometry::Location;
 pub use glam::{DVec2, DVec3};
