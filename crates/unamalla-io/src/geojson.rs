@@ -1,0 +1,428 @@
+//! Reading planar regions from GeoJSON (RFC 7946).
+//!
+//! # What is accepted
+//!
+//! * A bare geometry `Polygon`, `MultiPolygon` or `GeometryCollection`, a `Feature`, or a
+//!   `FeatureCollection`.
+//! * Every polygon found in the document is a **part**; parts are numbered 0, 1, … in document
+//!   order (features in order, the polygons of a `MultiPolygon` in order). A `FeatureCollection`
+//!   contributes the **union of the polygonal parts of all its features**; the
+//!   [`PartSelector`] then picks one part (by default the one whose outer ring has the largest
+//!   area). Non-polygonal geometries (points, line strings) *inside* a collection are skipped;
+//!   a non-polygonal geometry at the top level or as the geometry of a top-level `Feature` is
+//!   an error ([`IoError::WrongGeometryType`]). A `Feature` with a `null` geometry has no parts.
+//! * In each polygon ring 0 is the exterior and the rest are holes; **either orientation** is
+//!   accepted (the region constructor normalises to a counter-clockwise exterior and clockwise
+//!   holes).
+//! * Positions may have a third (elevation) component or more; only `x, y` are used.
+//! * A ring needs at least 4 positions (RFC 7946). The closing position (equal to the first) is
+//!   dropped, so rings come out **open**; a ring that is not closed is tolerated and used as is.
+//!
+//! Vertex indices in [`GeometryError`](unamalla_mesh::GeometryError)s of the selected part
+//! are 0-based position indices in the ring as written in the file.
+//!
+//! Errors carry the file path and the JSON path of the offending value (or the line and column
+//! for malformed JSON). Nothing in this module panics on any input.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use unamalla_mesh::{DVec2, Region};
+
+use crate::error::IoError;
+
+/// Which polygonal part of a GeoJSON document becomes the region.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum PartSelector {
+    /// The part whose outer ring encloses the largest area (the first one on ties).
+    #[default]
+    Largest,
+    /// The part with this 0-based index, in document order.
+    Index(usize),
+}
+
+/// The rings of one polygonal part as read from the file, before region validation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolygonRings {
+    /// The exterior ring, open (closing position dropped), orientation as in the file.
+    pub outer: Vec<DVec2>,
+    /// The holes, open, orientation as in the file.
+    pub holes: Vec<Vec<DVec2>>,
+    /// JSON path of the polygon's coordinate array, e.g. `$.features[2].geometry.coordinates`.
+    pub json_path: String,
+    /// 0-based part index in document order.
+    pub part: usize,
+}
+
+impl PolygonRings {
+    /// Area enclosed by the outer ring (absolute value of the shoelace formula), holes ignored.
+    pub fn outer_area(&self) -> f64 {
+        ring_area(&self.outer)
+    }
+
+    /// Total number of vertices over all rings (closing positions not counted).
+    pub fn num_vertices(&self) -> usize {
+        self.outer.len() + self.holes.iter().map(Vec::len).sum::<usize>()
+    }
+}
+
+/// Absolute area of a ring given open or closed (shoelace formula).
+fn ring_area(ring: &[DVec2]) -> f64 {
+    let n = ring.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let mut s = 0.0;
+    for k in 0..n {
+        let a = ring[k];
+        let b = ring[(k + 1) % n];
+        s += a.perp_dot(b);
+    }
+    0.5 * s.abs()
+}
+
+/// Reads a region from a GeoJSON file: the selected polygonal part, validated by
+/// [`Region::new`] (orientation normalised; repeated consecutive points are an error — see
+/// [`read_region_geojson_cleaned`]).
+pub fn read_region_geojson(path: impl AsRef<Path>, part: PartSelector) -> Result<Region, IoError> {
+    let path = path.as_ref();
+    let rings = read_region_rings(path, part)?;
+    to_region(rings, path, false).map(|(r, _)| r)
+}
+
+/// Like [`read_region_geojson`], for GeoJSON text held in memory (errors name `<string>`).
+pub fn parse_region_geojson(text: &str, part: PartSelector) -> Result<Region, IoError> {
+    let rings = parse_region_rings(text, part)?;
+    to_region(rings, Path::new(STRING_SOURCE), false).map(|(r, _)| r)
+}
+
+/// Like [`read_region_geojson`], but consecutive repeated points are removed (with
+/// [`Region::new_cleaned`]) instead of rejected; also returns how many were removed.
+pub fn read_region_geojson_cleaned(
+    path: impl AsRef<Path>,
+    part: PartSelector,
+) -> Result<(Region, usize), IoError> {
+    let path = path.as_ref();
+    let rings = read_region_rings(path, part)?;
+    to_region(rings, path, true)
+}
+
+/// Like [`read_region_geojson_cleaned`], for GeoJSON text held in memory.
+pub fn parse_region_geojson_cleaned(
+    text: &str,
+    part: PartSelector,
+) -> Result<(Region, usize), IoError> {
+    let rings = parse_region_rings(text, part)?;
+    to_region(rings, Path::new(STRING_SOURCE), true)
+}
+
+fn to_region(rings: PolygonRings, path: &Path, clean: bool) -> Result<(Region, usize), IoError> {
+    let PolygonRings {
+        outer,
+        holes,
+        json_path,
+        part,
+    } = rings;
+    let built = if clean {
+        Region::new_cleaned(outer, holes)
+    } else {
+        Region::new(outer, holes).map(|r| (r, 0))
+    };
+    built.map_err(|source| IoError::Geometry {
+        path: path.to_path_buf(),
+        json_path,
+        part,
+        source,
+    })
+}
+
+/// Path shown for inputs that were given as text rather than read from a file.
+pub(crate) const STRING_SOURCE: &str = "<string>";
+
+/// All polygonal parts of a GeoJSON document, in document order (see the module docs).
+pub fn parse_polygon_parts(text: &str) -> Result<Vec<PolygonRings>, IoError> {
+    parse_parts_at(text, Path::new(STRING_SOURCE))
+}
+
+/// Reads a GeoJSON file and returns the rings of the selected part, without validating them as
+/// a region (use this to repair input, e.g. with `Region::new_cleaned`).
+pub fn read_region_rings(
+    path: impl AsRef<Path>,
+    part: PartSelector,
+) -> Result<PolygonRings, IoError> {
+    let path = path.as_ref();
+    let text = read_text(path)?;
+    let parts = parse_parts_at(&text, path)?;
+    select_part(parts, part, path)
+}
+
+/// Like [`read_region_rings`], for GeoJSON text held in memory.
+pub fn parse_region_rings(text: &str, part: PartSelector) -> Result<PolygonRings, IoError> {
+    let path = Path::new(STRING_SOURCE);
+    let parts = parse_parts_at(text, path)?;
+    select_part(parts, part, path)
+}
+
+pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
+    std::fs::read_to_string(path).map_err(|source| IoError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Picks one part; `parts` must come from a successful parse (hence be non-empty), but an empty
+/// list is handled too.
+pub(crate) fn select_part(
+    parts: Vec<PolygonRings>,
+    part: PartSelector,
+    path: &Path,
+) -> Result<PolygonRings, IoError> {
+    let count = parts.len();
+    let index = match part {
+        PartSelector::Index(k) => k,
+        PartSelector::Largest => {
+            let mut best: Option<(usize, f64)> = None;
+            for (k, p) in parts.iter().enumerate() {
+                let a = p.outer_area();
+                if best.is_none_or(|(_, b)| a > b) {
+                    best = Some((k, a));
+                }
+            }
+            best.map(|(k, _)| k).unwrap_or(0)
+        }
+    };
+    parts
+        .into_iter()
+        .nth(index)
+        .ok_or_else(|| IoError::PartOutOfRange {
+            path: path.to_path_buf(),
+            index,
+            parts: count,
+        })
+}
+
+pub(crate) fn parse_parts_at(text: &str, path: &Path) -> Result<Vec<PolygonRings>, IoError> {
+    let value: Value = serde_json::from_str(text).map_err(|e| IoError::Json {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: strip_position(&e.to_string()),
+    })?;
+    let mut walker = Walker {
+        path,
+        parts: Vec::new(),
+        skipped: Vec::new(),
+    };
+    walker.object(&value, "$".to_string(), false)?;
+    if walker.parts.is_empty() {
+        return Err(IoError::NoPolygon {
+            path: path.to_path_buf(),
+            found: walker.skipped,
+        });
+    }
+    Ok(walker.parts)
+}
+
+/// serde_json appends " at line L column C" to its messages; the error carries those already.
+fn strip_position(msg: &str) -> String {
+    match msg.rfind(" at line ") {
+        Some(k) => msg[..k].to_string(),
+        None => msg.to_string(),
+    }
+}
+
+struct Walker<'p> {
+    path: &'p Path,
+    parts: Vec<PolygonRings>,
+    /// Types of non-polygonal geometries skipped inside collections.
+    skipped: Vec<String>,
+}
+
+const EXPECTED_TOP: &str =
+    "Polygon, MultiPolygon, GeometryCollection, Feature or FeatureCollection";
+
+impl Walker<'_> {
+    fn pb(&self) -> PathBuf {
+        self.path.to_path_buf()
+    }
+
+    fn missing(&self, json_path: &str, problem: String) -> IoError {
+        IoError::MissingMember {
+            path: self.pb(),
+            json_path: json_path.to_string(),
+            problem,
+        }
+    }
+
+    fn member<'v>(&self, obj: &'v Value, jp: &str, key: &str) -> Result<&'v Value, IoError> {
+        obj.get(key)
+            .ok_or_else(|| self.missing(jp, format!("missing member {key:?}")))
+    }
+
+    fn array<'v>(&self, v: &'v Value, jp: &str, what: &str) -> Result<&'v Vec<Value>, IoError> {
+        v.as_array().ok_or_else(|| {
+            self.missing(jp, format!("{what} must be an array, found {}", kind_of(v)))
+        })
+    }
+
+    /// A GeoJSON object; `in_collection` is true inside a FeatureCollection or
+    /// GeometryCollection, where non-polygonal geometries are skipped.
+    fn object(&mut self, v: &Value, jp: String, in_collection: bool) -> Result<(), IoError> {
+        if !v.is_object() {
+            return Err(self.missing(
+                &jp,
+                format!("expected a GeoJSON object, found {}", kind_of(v)),
+            ));
+        }
+        let ty = self.member(v, &jp, "type")?;
+        let ty = ty.as_str().ok_or_else(|| {
+            self.missing(
+                &jp,
+                format!("member \"type\" must be a string, found {}", kind_of(ty)),
+            )
+        })?;
+        match ty {
+            "Polygon" => {
+                let cjp = format!("{jp}.coordinates");
+                let coords = self.member(v, &jp, "coordinates")?;
+                let p = self.polygon(coords, cjp)?;
+                self.parts.push(p);
+            }
+            "MultiPolygon" => {
+                let cjp = format!("{jp}.coordinates");
+                let coords = self.member(v, &jp, "coordinates")?;
+                let polys = self.array(coords, &cjp, "MultiPolygon coordinates")?;
+                if polys.is_empty() {
+                    return Err(IoError::EmptyGeometry {
+                        path: self.pb(),
+                        json_path: cjp,
+                        what: "MultiPolygon",
+                    });
+                }
+                for (k, poly) in polys.iter().enumerate() {
+                    let p = self.polygon(poly, format!("{cjp}[{k}]"))?;
+                    self.parts.push(p);
+                }
+            }
+            "GeometryCollection" => {
+                let gjp = format!("{jp}.geometries");
+                let geoms = self.member(v, &jp, "geometries")?;
+                let geoms = self.array(geoms, &gjp, "\"geometries\"")?;
+                for (k, g) in geoms.iter().enumerate() {
+                    self.object(g, format!("{gjp}[{k}]"), true)?;
+                }
+            }
+            "Feature" => {
+                let g = self.member(v, &jp, "geometry")?;
+                if !g.is_null() {
+                    self.object(g, format!("{jp}.geometry"), in_collection)?;
+                }
+            }
+            "FeatureCollection" => {
+                let fjp = format!("{jp}.features");
+                let feats = self.member(v, &jp, "features")?;
+                let feats = self.array(feats, &fjp, "\"features\"")?;
+                for (k, f) in feats.iter().enumerate() {
+                    self.object(f, format!("{fjp}[{k}]"), true)?;
+                }
+            }
+            "Point" | "MultiPoint" | "LineString" | "MultiLineString" if in_collection => {
+                self.skipped.push(ty.to_string());
+            }
+            other => {
+                return Err(IoError::WrongGeometryType {
+                    path: self.pb(),
+                    json_path: jp,
+                    found: other.to_string(),
+                    expected: EXPECTED_TOP,
+                })
+            }
+        }
+        Ok(())
+    }
+
+    /// The coordinate array of one Polygon.
+    fn polygon(&self, coords: &Value, jp: String) -> Result<PolygonRings, IoError> {
+        let rings = self.array(coords, &jp, "Polygon coordinates")?;
+        if rings.is_empty() {
+            return Err(IoError::EmptyGeometry {
+                path: self.pb(),
+                json_path: jp,
+                what: "Polygon",
+            });
+        }
+        let mut out = Vec::with_capacity(rings.len());
+        for (r, ring) in rings.iter().enumerate() {
+            out.push(self.ring(ring, &format!("{jp}[{r}]"))?);
+        }
+        let mut it = out.into_iter();
+        let outer = it.next().unwrap_or_default();
+        Ok(PolygonRings {
+            outer,
+            holes: it.collect(),
+            json_path: jp,
+            part: self.parts.len(),
+        })
+    }
+
+    fn ring(&self, ring: &Value, jp: &str) -> Result<Vec<DVec2>, IoError> {
+        let positions = self.array(ring, jp, "a linear ring")?;
+        if positions.len() < 4 {
+            return Err(IoError::RingTooShort {
+                path: self.pb(),
+                json_path: jp.to_string(),
+                positions: positions.len(),
+            });
+        }
+        let mut pts = Vec::with_capacity(positions.len());
+        for (k, pos) in positions.iter().enumerate() {
+            pts.push(self.position(pos, &format!("{jp}[{k}]"))?);
+        }
+        if pts.len() > 1 && pts.first() == pts.last() {
+            pts.pop();
+        }
+        Ok(pts)
+    }
+
+    fn position(&self, pos: &Value, jp: &str) -> Result<DVec2, IoError> {
+        let bad = |problem: String| IoError::BadCoordinate {
+            path: self.pb(),
+            json_path: jp.to_string(),
+            problem,
+        };
+        let arr = pos.as_array().ok_or_else(|| {
+            bad(format!(
+                "a position must be an array of numbers, found {}",
+                kind_of(pos)
+            ))
+        })?;
+        if arr.len() < 2 {
+            return Err(bad(format!(
+                "a position needs at least 2 numbers, found {}",
+                arr.len()
+            )));
+        }
+        let mut xy = [0.0; 2];
+        for (c, slot) in xy.iter_mut().enumerate() {
+            let v = &arr[c];
+            *slot = v.as_f64().ok_or_else(|| IoError::BadCoordinate {
+                path: self.pb(),
+                json_path: format!("{jp}[{c}]"),
+                problem: format!("coordinate must be a number, found {}", kind_of(v)),
+            })?;
+        }
+        Ok(DVec2::new(xy[0], xy[1]))
+    }
+}
+
+fn kind_of(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}

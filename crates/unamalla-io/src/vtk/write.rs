@@ -1,0 +1,205 @@
+//! VTK legacy ASCII writers.
+
+use std::collections::HashSet;
+use std::io::{self, Write};
+use std::path::Path;
+
+use unamalla_mesh::{
+    DVec2, DVec3, HasHexCells, HasNodes, HasQuadCells, StructuredGrid2, StructuredGrid3,
+};
+
+use crate::atomic::atomic_write;
+use crate::error::IoError;
+
+/// VTK cell type of a 4-node quadrilateral.
+pub const VTK_QUAD: u8 = 9;
+/// VTK cell type of an 8-node hexahedron.
+pub const VTK_HEXAHEDRON: u8 = 12;
+
+/// The first line every writer emits.
+pub(crate) const HEADER: &str = "# vtk DataFile Version 3.0";
+/// The title line every writer emits.
+pub(crate) const TITLE: &str = "written by unamalla-io";
+
+/// Named per-cell arrays: `(name, one value per cell)`.
+pub type CellData<'a> = [(&'a str, &'a [f64])];
+
+/// Writes a structured 2D grid as `DATASET STRUCTURED_GRID` with `DIMENSIONS m n 1` and `z = 0`
+/// (node order `j * m + i`, which is VTK's x-fastest order), followed by the cell arrays.
+pub fn write_vtk_structured2(
+    path: impl AsRef<Path>,
+    grid: &StructuredGrid2,
+    cell_data: &CellData<'_>,
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    check_cell_data(path, grid.num_cells(), cell_data)?;
+    atomic_write(path, |w| {
+        write_head(w, "STRUCTURED_GRID")?;
+        writeln!(w, "DIMENSIONS {} {} 1", grid.m(), grid.n())?;
+        write_points2(w, grid.nodes())?;
+        write_cell_data(w, grid.num_cells(), cell_data)
+    })
+}
+
+/// Writes a structured 3D grid as `DATASET STRUCTURED_GRID` with `DIMENSIONS m n p`
+/// (node order `(k * n + j) * m + i`), followed by the cell arrays.
+pub fn write_vtk_structured3(
+    path: impl AsRef<Path>,
+    grid: &StructuredGrid3,
+    cell_data: &CellData<'_>,
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    check_cell_data(path, grid.num_cells(), cell_data)?;
+    let (m, n, p) = grid.dims();
+    atomic_write(path, |w| {
+        write_head(w, "STRUCTURED_GRID")?;
+        writeln!(w, "DIMENSIONS {m} {n} {p}")?;
+        write_points3(w, grid.nodes())?;
+        write_cell_data(w, grid.num_cells(), cell_data)
+    })
+}
+
+/// Writes any quad mesh (a [`QuadMesh`](unamalla_mesh::QuadMesh), a structured grid, …) as
+/// `DATASET UNSTRUCTURED_GRID` with `z = 0` and cell type 9, cells in the mesh's order.
+pub fn write_vtk_quads<M: HasQuadCells + ?Sized>(
+    path: impl AsRef<Path>,
+    mesh: &M,
+    cell_data: &CellData<'_>,
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    let nc = mesh.num_quads();
+    check_cell_data(path, nc, cell_data)?;
+    atomic_write(path, |w| {
+        write_head(w, "UNSTRUCTURED_GRID")?;
+        write_points2(w, mesh.nodes())?;
+        writeln!(w, "CELLS {nc} {}", nc * 5)?;
+        for c in 0..nc {
+            let [a, b, cc, d] = mesh.quad(c);
+            writeln!(w, "4 {a} {b} {cc} {d}")?;
+        }
+        write_cell_types(w, nc, VTK_QUAD)?;
+        write_cell_data(w, nc, cell_data)
+    })
+}
+
+/// Writes any hex mesh as `DATASET UNSTRUCTURED_GRID` with cell type 12 (VTK vertex order,
+/// which is the crate family's order), cells in the mesh's order.
+pub fn write_vtk_hexes<M: HasHexCells + ?Sized>(
+    path: impl AsRef<Path>,
+    mesh: &M,
+    cell_data: &CellData<'_>,
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    let nc = mesh.num_hexes();
+    check_cell_data(path, nc, cell_data)?;
+    atomic_write(path, |w| {
+        write_head(w, "UNSTRUCTURED_GRID")?;
+        write_points3(w, mesh.nodes())?;
+        writeln!(w, "CELLS {nc} {}", nc * 9)?;
+        for c in 0..nc {
+            let h = mesh.hex(c);
+            write!(w, "8")?;
+            for v in h {
+                write!(w, " {v}")?;
+            }
+            writeln!(w)?;
+        }
+        write_cell_types(w, nc, VTK_HEXAHEDRON)?;
+        write_cell_data(w, nc, cell_data)
+    })
+}
+
+/// Checks the cell arrays: one finite value per cell, and valid, distinct names.
+///
+/// Names must be non-empty printable ASCII without whitespace (VTK legacy separates tokens by
+/// whitespace, so a name with a blank cannot be read back); they are rejected, never changed.
+pub(crate) fn check_cell_data(
+    path: &Path,
+    num_cells: usize,
+    cell_data: &CellData<'_>,
+) -> Result<(), IoError> {
+    let mut seen = HashSet::new();
+    for &(name, values) in cell_data {
+        let bad_name = |reason| IoError::InvalidArrayName {
+            path: path.to_path_buf(),
+            name: name.to_string(),
+            reason,
+        };
+        if name.is_empty() {
+            return Err(bad_name("it is empty"));
+        }
+        if !name.bytes().all(|b| b.is_ascii_graphic()) {
+            return Err(bad_name(
+                "it must be printable ASCII without whitespace (VTK legacy splits tokens on whitespace)",
+            ));
+        }
+        if !seen.insert(name) {
+            return Err(bad_name("another cell array has the same name"));
+        }
+        if values.len() != num_cells {
+            return Err(IoError::CellDataLength {
+                path: path.to_path_buf(),
+                name: name.to_string(),
+                expected: num_cells,
+                found: values.len(),
+            });
+        }
+        if let Some((cell, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(IoError::NonFiniteValue {
+                path: path.to_path_buf(),
+                name: name.to_string(),
+                cell,
+                value,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn write_head(w: &mut dyn Write, dataset: &str) -> io::Result<()> {
+    writeln!(w, "{HEADER}")?;
+    writeln!(w, "{TITLE}")?;
+    writeln!(w, "ASCII")?;
+    writeln!(w, "DATASET {dataset}")
+}
+
+/// Coordinates use Rust's `{:?}` formatting of `f64`: the shortest decimal string that parses
+/// back to the same bits (e.g. `0.1`, `1e-7`, `-0.0`), which C `strtod` and numpy read exactly.
+fn write_points2(w: &mut dyn Write, nodes: &[DVec2]) -> io::Result<()> {
+    writeln!(w, "POINTS {} double", nodes.len())?;
+    for p in nodes {
+        writeln!(w, "{:?} {:?} 0", p.x, p.y)?;
+    }
+    Ok(())
+}
+
+fn write_points3(w: &mut dyn Write, nodes: &[DVec3]) -> io::Result<()> {
+    writeln!(w, "POINTS {} double", nodes.len())?;
+    for p in nodes {
+        writeln!(w, "{:?} {:?} {:?}", p.x, p.y, p.z)?;
+    }
+    Ok(())
+}
+
+fn write_cell_types(w: &mut dyn Write, nc: usize, ty: u8) -> io::Result<()> {
+    writeln!(w, "CELL_TYPES {nc}")?;
+    for _ in 0..nc {
+        writeln!(w, "{ty}")?;
+    }
+    Ok(())
+}
+
+fn write_cell_data(w: &mut dyn Write, nc: usize, cell_data: &CellData<'_>) -> io::Result<()> {
+    if cell_data.is_empty() {
+        return Ok(());
+    }
+    writeln!(w, "CELL_DATA {nc}")?;
+    for &(name, values) in cell_data {
+        writeln!(w, "SCALARS {name} double 1")?;
+        writeln!(w, "LOOKUP_TABLE default")?;
+        for v in values {
+            writeln!(w, "{v:?}")?;
+        }
+    }
+    Ok(())
+}
