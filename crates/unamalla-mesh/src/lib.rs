@@ -32,6 +32,7 @@ pub use error::{GeometryError, MeshError, RingId};
 pub use geometry::Location;
 pub use glam::{DVec2, DVec3};
 pub use grid::{StructuredGrid2, StructuredGrid3};
+pub use quality::{HexMetrics, QuadMetrics, QualityReport, ReportOptions};
 pub use region::{Polygon, Region};
 pub use resample::resample_arc_length;
 pub use spatial::{EdgeRef, SegmentIndex};

@@ -141,7 +141,13 @@ impl SvgCanvas {
         for ring in rings {
             for (k, p) in ring.iter().enumerate() {
                 let q = self.to_px(*p);
-                let _ = write!(d, "{}{:.2},{:.2} ", if k == 0 { "M" } else { "L" }, q.x, q.y);
+                let _ = write!(
+                    d,
+                    "{}{:.2},{:.2} ",
+                    if k == 0 { "M" } else { "L" },
+                    q.x,
+                    q.y
+                );
             }
             d.push_str("Z ");
         }
@@ -220,7 +226,10 @@ mod tests {
         assert_eq!(c.to_px(DVec2::new(0., 0.)), DVec2::new(10., 60.));
         assert_eq!(c.to_px(DVec2::new(10., 5.)), DVec2::new(110., 10.));
         let mut c = c;
-        c.polygon(&[DVec2::ZERO, DVec2::X, DVec2::Y], &Style::fill_stroke("blue", "black", 1.0));
+        c.polygon(
+            &[DVec2::ZERO, DVec2::X, DVec2::Y],
+            &Style::fill_stroke("blue", "black", 1.0),
+        );
         c.text(DVec2::new(5., 2.), "a<b", 10.0, "red");
         let s = c.finish();
         assert!(s.starts_with("<svg"));

@@ -15,7 +15,7 @@
 //! (`ξ_i = ½(s_b(i) + s_t(i))`, `η_j = ½(s_l(j) + s_r(j))`), which keeps the interior spacing
 //! close to the boundary spacing when the boundary points are not uniform.
 //!
-//! **3D** (seed 004 digest §2, recommended reading [I]): the Boolean sum
+//! **3D** (seed 004 digest §2, recommended reading marked "I"): the Boolean sum
 //! `X = U + V + W − UV − UW − VW + UVW` of the linear blends between opposite faces, edges and
 //! corners, with uniform parameters `ξ_i = i/(m−1)` etc.
 

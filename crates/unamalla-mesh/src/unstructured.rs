@@ -268,7 +268,7 @@ mod tests {
         let h = HexMesh::from_grid(&g);
         let rebuilt = HexMesh::new(h.nodes().to_vec(), h.cells().to_vec()).unwrap();
         assert_eq!(rebuilt.fixed(), h.fixed());
-        assert_eq!(h.num_free(), 2 * 1 * 3);
+        assert_eq!(h.num_free(), 2 * 3); // (4−2)(3−2)(5−2)
     }
 
     #[test]

@@ -1,0 +1,172 @@
+//! End-to-end tests of the `unamalla` binary: the documented commands work, bad input gives
+//! one clear error line, a non-zero exit code and no output file.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_unamalla"))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/regions")
+        .join(name)
+}
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("unamalla-cli-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn tfi_on_colorado_then_quality_json() {
+    let dir = tmpdir("tfi");
+    let out = dir.join("co.vtk");
+    let st = bin()
+        .args(["tfi"])
+        .arg(fixture("colorado.geojson"))
+        .args(["--auto-corners", "--size", "60x40", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let text = String::from_utf8_lossy(&st.stdout);
+    assert!(text.contains("non-convex cells: 0"), "{text}");
+
+    let q = bin()
+        .arg("quality")
+        .arg(&out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(q.status.success(), "{}", String::from_utf8_lossy(&q.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&q.stdout).unwrap();
+    // 60 × 40 nodes → 59 × 39 cells
+    assert_eq!(v["num_cells"], 59 * 39);
+    assert_eq!(v["num_nodes"], 60 * 40);
+    assert_eq!(v["non_convex_cells"], 0);
+    // Colorado is nearly a rectangle: every cell is close to one
+    let mu_min = v["metrics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "mu")
+        .unwrap()["min"]
+        .as_f64()
+        .unwrap();
+    assert!(mu_min > 0.9, "min mu {mu_min}");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn explicit_corners_are_file_indices() {
+    let dir = tmpdir("corners");
+    let out = dir.join("sq.vtk");
+    let region = dir.join("sq.geojson");
+    // clockwise square in the file, corners listed in file order starting at (0,0)
+    std::fs::write(
+        &region,
+        r#"{"type":"Polygon","coordinates":[[[0,0],[0,2],[1,2],[2,2],[2,0],[0,0]]]}"#,
+    )
+    .unwrap();
+    let st = bin()
+        .arg("tfi")
+        .arg(&region)
+        .args(["--corners", "0,4,3,1", "--size", "3x3", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let q = bin()
+        .arg("quality")
+        .arg(&out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&q.stdout).unwrap();
+    assert_eq!(v["num_cells"], 4);
+    // a square split into 2 × 2 squares: every mu is exactly 1 (up to rounding)
+    let mu = v["metrics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "mu")
+        .unwrap()
+        .clone();
+    assert!((mu["min"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+fn assert_clean_failure(args: &[&str], out: &Path) {
+    let st = bin().args(args).output().unwrap();
+    assert!(!st.status.success());
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(
+        err.trim().lines().count(),
+        1,
+        "expected one error line, got: {err}"
+    );
+    assert!(err.starts_with("error: "), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!out.exists(), "a failed run left {}", out.display());
+}
+
+#[test]
+fn bad_regions_fail_cleanly_without_output() {
+    let dir = tmpdir("bad");
+    let out = dir.join("never.vtk");
+    let o = out.to_str().unwrap();
+    let cases = [
+        (
+            "bowtie.geojson",
+            r#"{"type":"Polygon","coordinates":[[[0,0],[2,2],[2,0],[0,2],[0,0]]]}"#,
+        ),
+        (
+            "hole-outside.geojson",
+            r#"{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,1],[0,0]],[[5,5],[6,5],[6,6],[5,5]]]}"#,
+        ),
+        (
+            "broken.geojson",
+            r#"{"type":"Polygon","coordinates":[[[0,0],[1,0]"#,
+        ),
+        (
+            "line.geojson",
+            r#"{"type":"LineString","coordinates":[[0,0],[1,0]]}"#,
+        ),
+    ];
+    for (name, text) in cases {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        assert_clean_failure(
+            &["tfi", p.to_str().unwrap(), "--size", "5x5", "-o", o],
+            &out,
+        );
+    }
+    // a region with a hole is not four-sided
+    assert_clean_failure(
+        &[
+            "tfi",
+            fixture("horse.geojson").to_str().unwrap(),
+            "--size",
+            "5x5",
+            "-o",
+            o,
+        ],
+        &out,
+    );
+    assert_clean_failure(
+        &["quality", dir.join("missing.vtk").to_str().unwrap()],
+        &out,
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -1,0 +1,58 @@
+//! # unamalla-core
+//!
+//! The crate simulation codes add (`cargo add unamalla-core`). It re-exports the stage crates
+//! and offers the high-level operations:
+//!
+//! * [`single_block`]: one structured grid on a roughly four-sided region by transfinite
+//!   interpolation (seed 000 digest §5.1) between four arc-length-resampled sides (§4.5), with
+//!   automatic corners ([`corners`], §4.2) or corners given by the user;
+//! * quality reports ([`mesh::quality::QualityReport`]) and file formats ([`io`]).
+//!
+//! ```
+//! use unamalla_core::{mesh::{DVec2, Region, quality::QualityReport}, single_block};
+//!
+//! // a curved four-sided region
+//! let mut ring = Vec::new();
+//! for k in 0..20 { let t = k as f64 / 20.0; ring.push(DVec2::new(4.0 * t, 0.3 * (6.0 * t).sin())); }
+//! for k in 0..10 { let t = k as f64 / 10.0; ring.push(DVec2::new(4.0, 2.0 * t)); }
+//! for k in 0..20 { let t = k as f64 / 20.0; ring.push(DVec2::new(4.0 * (1.0 - t), 2.0)); }
+//! for k in 0..10 { let t = k as f64 / 10.0; ring.push(DVec2::new(0.0, 2.0 * (1.0 - t))); }
+//! let region = Region::new(ring, vec![]).unwrap();
+//! let grid = single_block::tfi_region(&region, single_block::Corners::Auto, 41, 21).unwrap();
+//! let report = QualityReport::for_quads(&grid);
+//! assert_eq!(report.non_convex_cells, 0);
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod corners;
+pub mod render;
+pub mod single_block;
+
+pub use unamalla_io as io;
+
+/// The README's examples, compiled and run by `cargo test --doc`.
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
+pub use unamalla_mesh as mesh;
+
+/// Errors of the high-level operations.
+#[derive(Debug, thiserror::Error)]
+pub enum CoreError {
+    /// Invalid region geometry.
+    #[error(transparent)]
+    Geometry(#[from] unamalla_mesh::GeometryError),
+    /// A mesh operation failed.
+    #[error(transparent)]
+    Mesh(#[from] unamalla_mesh::MeshError),
+    /// Reading or writing a file failed.
+    #[error(transparent)]
+    Io(#[from] unamalla_io::IoError),
+    /// Corners could not be chosen or the given ones are invalid.
+    #[error("corners: {0}")]
+    Corners(String),
+    /// The operation does not apply to this region.
+    #[error("{0}")]
+    Unsupported(String),
+}
