@@ -250,6 +250,57 @@ pub enum IoError {
         /// Why it was rejected.
         reason: &'static str,
     },
+    /// A binary file is malformed (bad record marker, truncated record, impossible size, …).
+    #[error("{}: byte {offset}: {message}", .path.display())]
+    MalformedBinary {
+        /// The file.
+        path: PathBuf,
+        /// 0-based byte offset where the problem was found.
+        offset: u64,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// The rings read from a contour or region file do not form a valid region.
+    #[error("{}: invalid region: {source}", .path.display())]
+    InvalidRegion {
+        /// The file.
+        path: PathBuf,
+        /// The validation error (vertex indices are 0-based positions in the ring as read).
+        #[source]
+        source: GeometryError,
+    },
+
+    /// A named group of boundary elements given to a writer is unusable (bad name, node id out
+    /// of range, duplicate name, …).
+    #[error("{}: group {name:?}: {reason}", .path.display())]
+    InvalidGroup {
+        /// The target file.
+        path: PathBuf,
+        /// The group name.
+        name: String,
+        /// Why it was rejected.
+        reason: String,
+    },
+
+    /// The input given to a writer cannot be represented in the format (e.g. a 3D Plot3D file
+    /// with 2D blocks, a record too large for a Fortran record marker).
+    #[error("{}: cannot write: {reason}", .path.display())]
+    Unrepresentable {
+        /// The target file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+
+    /// The `shapefile` crate rejected the file.
+    #[error("{}: shapefile: {message}", .path.display())]
+    Shapefile {
+        /// The file.
+        path: PathBuf,
+        /// What the `shapefile` crate reported.
+        message: String,
+    },
 }
 
 fn fmt_found(found: &[String]) -> String {

@@ -5,8 +5,29 @@
 //! | format | read | write | module |
 //! |---|---|---|---|
 //! | GeoJSON (RFC 7946) `Polygon` / `MultiPolygon` / `Feature` / `FeatureCollection` | regions | – | [`geojson`] |
+//! | ESRI Shapefile, polygon shapes (5, 15, 25) | regions | regions (`.shp` + `.shx`) | [`shp`] |
+//! | UNAMALLA contour `.con` (`ibflag` 0/1/13/24, side counts) | contours, regions | contours | [`legacy`] |
+//! | plain text rings (`x y` per line, blank line between rings) | regions | regions | [`rings`] |
+//! | Gmsh MSH 4.1 ASCII: quads (3) / hexahedra (5), `$Entities`, `$PhysicalNames`, named boundary groups | yes | yes | [`msh`] |
+//! | VTK XML `.vts` (one structured block, 2D or 3D) | yes | yes | [`vtk_xml`] |
+//! | VTK XML `.vtu` (quads or hexahedra) | yes | yes | [`vtk_xml`] |
+//! | VTK XML `.vtm` multiblock index; whole block meshes ([`write_block_mesh`]) | index | yes | [`vtk_xml`] |
 //! | VTK legacy ASCII, `STRUCTURED_GRID` (2D and 3D) | yes | yes | [`vtk`] |
 //! | VTK legacy ASCII, `UNSTRUCTURED_GRID` of quads (9) or hexahedra (12) | yes | yes | [`vtk`] |
+//! | Plot3D multi-block grids, 2D and 3D, ASCII and Fortran-unformatted binary | yes | yes | [`plot3d`] |
+//! | UNAMALLA XY and RED meshes | yes | yes | [`legacy`] |
+//! | Geomview `MESH` surface | yes | yes | [`legacy`] |
+//! | OFF / Wavefront OBJ (quad meshes; hex meshes as boundary surfaces) | polygon surfaces | yes | [`surface`] |
+//!
+//! Every mesh writer takes per-cell arrays where the format has them (VTK legacy and XML: e.g.
+//! quality metrics as `CellData`). Formats that store boundary groups (MSH) take them named;
+//! [`boundary_edge_groups`] and [`hex_boundary_faces`] compute the boundary of a mesh.
+//!
+//! Independent checks with real readers live in `scripts/` and run from the tests when Python
+//! has the package (otherwise the test prints "skipped: …" and passes): Gmsh's own API
+//! (`check_msh_gmsh.py`, PyPI `gmsh`), meshio (`check_vtk_meshio.py`, `.vtk` and `.vtu`) and
+//! VTK's XML readers (`check_vtk_xml_vtk.py`, PyPI `vtk`, `.vts`/`.vtu`/`.vtm`; meshio has no
+//! `.vts` reader).
 //!
 //! ## Conventions
 //!
@@ -19,14 +40,14 @@
 //!   counter-clockwise, hexahedra are in VTK order. 2D meshes are written with `z = 0` and
 //!   read back only if every `z` is 0.
 //! * Numbers are written with the shortest decimal representation that round-trips, so
-//!   write → read reproduces every `f64` bit for bit.
+//!   write → read reproduces every `f64` bit for bit (binary Plot3D stores the bits).
 //!
 //! ## Errors
 //!
 //! Every function returns [`IoError`]. Errors caused by file content carry the file path (or
 //! `<string>` for text parsed from memory) and a 1-based line number (text formats, malformed
-//! JSON) or a JSON path (well-formed JSON with the wrong content). No function panics on any
-//! input.
+//! JSON), a byte offset (binary Plot3D), the `shapefile` crate's message (Shapefile) or a JSON path (well-formed JSON with the wrong
+//! content). No function panics on any input.
 //!
 //! ## Atomic writes
 //!
@@ -66,7 +87,17 @@
 pub mod atomic;
 pub mod error;
 pub mod geojson;
+pub mod legacy;
+pub mod msh;
+pub mod plot3d;
+pub mod rings;
+pub mod shp;
+pub mod surface;
 pub mod vtk;
+pub mod vtk_xml;
+
+mod lex;
+mod xml;
 
 pub use atomic::atomic_write;
 pub use error::IoError;
@@ -75,7 +106,32 @@ pub use geojson::{
     read_region_geojson, read_region_geojson_cleaned, read_region_rings, PartSelector,
     PolygonRings,
 };
+pub use legacy::{
+    parse_con, parse_geomview_mesh, parse_red, parse_xy, read_con, read_geomview_mesh, read_red,
+    read_region_con, read_xy, write_con, write_geomview_mesh, write_red, write_xy, Contour,
+    GeomviewMesh, Ibflag, LegacyMesh,
+};
+pub use msh::{
+    boundary_edge_groups, boundary_loops, hex_boundary_faces, parse_msh, read_msh, write_msh_hexes,
+    write_msh_quads, BoundaryLoop, EdgeGroup, FaceGroup, MshFile, MshMesh,
+};
+pub use plot3d::{
+    parse_plot3d_ascii, parse_plot3d_binary, read_plot3d, write_plot3d2, write_plot3d3,
+    Plot3dBlocks, Plot3dDim, Plot3dFormat,
+};
+pub use rings::{
+    parse_region_text, parse_rings_text, read_region_text, read_rings_text, write_region_text,
+};
+pub use shp::{read_region_shapefile, read_shapefile_parts, write_region_shapefile};
+pub use surface::{
+    parse_obj, parse_off, read_obj, read_off, write_obj_hexes, write_obj_quads, write_off_hexes,
+    write_off_quads, SurfaceMesh,
+};
 pub use vtk::{
     parse_vtk, read_vtk, write_vtk_hexes, write_vtk_quads, write_vtk_structured2,
     write_vtk_structured3, VtkFile, VtkMesh,
+};
+pub use vtk_xml::{
+    parse_vtk_xml, read_vtk_xml, read_vtm, write_block_mesh, write_vtm, write_vts2, write_vts3,
+    write_vtu_hexes, write_vtu_quads, BlockMeshFiles, VtmEntry,
 };

@@ -49,6 +49,7 @@ mod read;
 mod write;
 
 pub use read::{parse_vtk, read_vtk, VtkFile, VtkMesh};
+pub(crate) use write::check_cell_data;
 pub use write::{
     write_vtk_hexes, write_vtk_quads, write_vtk_structured2, write_vtk_structured3, CellData,
     VTK_HEXAHEDRON, VTK_QUAD,

@@ -1,0 +1,130 @@
+//! A plain compressed-sparse-row matrix used for the Hessians.
+//!
+//! Why not `nalgebra-sparse`: the optimizer needs to refresh the *values* of a fixed pattern in
+//! place, from many threads at once, at positions computed from the mesh connectivity
+//! (`row_offsets[r] + dim·k + c'`, see [`Csr::block_index`]). Keeping the three arrays as public
+//! fields makes that direct, keeps the column indices at 32 bits (a 1000 × 1000 quad grid has
+//! 36 M Hessian entries) and adds no dependency. Converting to any other CSR type is a copy of the
+//! three arrays.
+
+use rayon::prelude::*;
+
+/// A sparse matrix in compressed-sparse-row form with **both** triangles stored (the Hessians
+/// are symmetric; storing both makes products and row access trivial).
+///
+/// * `row_offsets` has `nrows + 1` entries; row `r` occupies `row_offsets[r]..row_offsets[r+1]`
+///   of `col_indices` and `values`;
+/// * `col_indices` are sorted increasingly inside each row;
+/// * for the Hessians of this crate the variables are the free-node coordinates interleaved
+///   (`x = [x₀, y₀, x₁, y₁, …]` in 2D, `[x₀, y₀, z₀, …]` in 3D), and every pair of
+///   neighbouring free nodes contributes a dense `dim × dim` block, so the pattern is a block
+///   pattern stored entry-wise.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Csr {
+    /// Number of rows.
+    pub nrows: usize,
+    /// Number of columns.
+    pub ncols: usize,
+    /// Start of each row in `col_indices` / `values` (`nrows + 1` entries).
+    pub row_offsets: Vec<usize>,
+    /// Column of each stored entry.
+    pub col_indices: Vec<u32>,
+    /// Value of each stored entry.
+    pub values: Vec<f64>,
+}
+
+impl Csr {
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.values.len()
+    }
+
+    /// The entry `(r, c)`, or 0 if it is not stored (or out of range).
+    pub fn get(&self, r: usize, c: usize) -> f64 {
+        if r >= self.nrows {
+            return 0.0;
+        }
+        let (s, e) = (self.row_offsets[r], self.row_offsets[r + 1]);
+        match self.col_indices[s..e].binary_search(&(c as u32)) {
+            Ok(k) => self.values[s + k],
+            Err(_) => 0.0,
+        }
+    }
+
+    /// `out = A v`, computed row by row in parallel (each row is summed sequentially, so the
+    /// result does not depend on the number of threads).
+    ///
+    /// # Panics
+    /// If `v.len() != ncols` or `out.len() != nrows`.
+    pub fn mul_vec(&self, v: &[f64], out: &mut [f64]) {
+        assert_eq!(v.len(), self.ncols, "Csr::mul_vec: v has the wrong length");
+        assert_eq!(
+            out.len(),
+            self.nrows,
+            "Csr::mul_vec: out has the wrong length"
+        );
+        out.par_iter_mut()
+            .with_min_len(1024)
+            .enumerate()
+            .for_each(|(r, o)| {
+                let (s, e) = (self.row_offsets[r], self.row_offsets[r + 1]);
+                let mut acc = 0.0;
+                for k in s..e {
+                    acc += self.values[k] * v[self.col_indices[k] as usize];
+                }
+                *o = acc;
+            });
+    }
+
+    /// The diagonal entries (0 where not stored).
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.nrows).map(|r| self.get(r, r)).collect()
+    }
+
+    /// A dense copy (row-major), for tests and small problems.
+    pub fn to_dense(&self) -> Vec<Vec<f64>> {
+        let mut d = vec![vec![0.0; self.ncols]; self.nrows];
+        for (r, row) in d.iter_mut().enumerate() {
+            for k in self.row_offsets[r]..self.row_offsets[r + 1] {
+                row[self.col_indices[k] as usize] = self.values[k];
+            }
+        }
+        d
+    }
+
+    /// Index into `values` of entry `(dim·a + ra, dim·b + rb)` of a block pattern built by this
+    /// crate, where `k` is the position of node-variable `b` in the sorted neighbour list of
+    /// node-variable `a` (every node row lists the same neighbours, each as `dim` columns).
+    #[inline]
+    pub fn block_index(&self, dim: usize, a: usize, k: usize, ra: usize, rb: usize) -> usize {
+        self.row_offsets[dim * a + ra] + dim * k + rb
+    }
+
+    /// Builds the block pattern (zero values) from sorted neighbour lists of node variables.
+    pub(crate) fn from_block_pattern(dim: usize, nbr_offsets: &[usize], nbr: &[u32]) -> Csr {
+        let nfree = nbr_offsets.len() - 1;
+        let nrows = dim * nfree;
+        let mut row_offsets = Vec::with_capacity(nrows + 1);
+        row_offsets.push(0);
+        let mut col_indices = Vec::with_capacity(dim * dim * nbr.len());
+        for a in 0..nfree {
+            let list = &nbr[nbr_offsets[a]..nbr_offsets[a + 1]];
+            for _ in 0..dim {
+                for &b in list {
+                    for rb in 0..dim {
+                        col_indices.push(b * dim as u32 + rb as u32);
+                    }
+                }
+                row_offsets.push(col_indices.len());
+            }
+        }
+        let nnz = col_indices.len();
+        Csr {
+            nrows,
+            ncols: nrows,
+            row_offsets,
+            col_indices,
+            values: vec![0.0; nnz],
+        }
+    }
+}

@@ -1,0 +1,797 @@
+//! 2D functionals on quad meshes: [`QuadTopology`] (connectivity, free-variable map, fixed
+//! coordinates) and [`QuadFunctional`] (a topology plus a [`TriKernel`]), which implements
+//! [`Problem`].
+//!
+//! # The generic derivative path
+//! For a leg pair `a = X_{n₁} − X_{n₀}`, `b = X_{n₃} − X_{n₂}` (corner triangle at `P = v_k`:
+//! `n₀ = n₂ = k`, `n₁ = k+1`, `n₃ = k−1`) let `u = (aₓ, a_y, bₓ, b_y)` and
+//! `s = (α, la, lb, o) = (aₓb_y − a_ybₓ, |a|², |b|², a·b)`. Then
+//!
+//! * `∇ᵤα = (b_y, −bₓ, −a_y, aₓ)` (i.e. `∂α/∂a = J₂b`, `∂α/∂b = −J₂a`, `J₂w = (w_y, −w_x)`),
+//!   `∇ᵤla = (2a, 0)`, `∇ᵤlb = (0, 2b)`, `∇ᵤo = (b, a)`;
+//! * `∇²ᵤα` has `+1` at `(aₓ, b_y)` and `−1` at `(a_y, bₓ)`, `∇²ᵤla = 2I_a`, `∇²ᵤlb = 2I_b`,
+//!   `∇²ᵤo` has `1` at `(aₓ, bₓ)` and `(a_y, b_y)` (all constant);
+//! * `∇ᵤf = Σₛ fₛ ∇ᵤs`, `∇²ᵤf = Jᵀ (∂²f/∂s²) J + Σₛ fₛ ∇²ᵤs` with `J = ∂s/∂u`;
+//! * node derivatives follow from `a = X_{n₁} − X_{n₀}`, `b = X_{n₃} − X_{n₂}`: `n₁` receives
+//!   `+∂f/∂a`, `n₀` receives `−∂f/∂a` (and likewise for `b`), and the Hessian block of nodes
+//!   `(i, j)` is `Σ σᵢσⱼ ∂²f/∂Lᵢ∂Lⱼ` over the legs `Lᵢ ∋ i`, `Lⱼ ∋ j` with signs `σ = ±1`.
+//!
+//! This one exact path serves every kernel (seed 001 digest §2.4 derivative kit, checked against
+//! finite differences in the tests).
+
+use std::sync::Arc;
+
+use glam::DVec2;
+use rayon::prelude::*;
+use unamalla_mesh::{FreeNodes, HasQuadCells};
+
+use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
+use crate::csr::Csr;
+use crate::error::FunctionalError;
+use crate::kernels2::{Order, Terms, TriKernel, TriScalars};
+use crate::problem::{LocalModel, Problem};
+
+/// Leg nodes `(n₀, n₁, n₂, n₃)` of corner `k` (`a = X_{n₁} − X_{n₀}`, `b = X_{n₃} − X_{n₂}`) and,
+/// at index 4, of the diagonal pair.
+const LEGS: [[usize; 4]; 5] = [
+    [0, 1, 0, 3],
+    [1, 2, 1, 0],
+    [2, 3, 2, 1],
+    [3, 0, 3, 2],
+    [0, 2, 1, 3],
+];
+
+/// Summary of the corner-triangle measures of a quad mesh (seed 001 digest §1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlphaSummary {
+    /// `α₋ = min α`.
+    pub min: f64,
+    /// `max α`.
+    pub max: f64,
+    /// `ᾱ = Σα / N` at this `x` (constant for a fixed boundary: `4·area(Ω)/N`).
+    pub mean: f64,
+    /// Number of corner triangles with `α ≤ 0`.
+    pub nonpositive_triangles: usize,
+    /// Number of cells with some `α ≤ 0` (non-convex or degenerate cells).
+    pub nonconvex_cells: usize,
+}
+
+/// Topology of a quad mesh prepared for evaluation: cells, free-variable map, Hessian pattern,
+/// deterministic parallel schedule and the coordinates of the fixed nodes.
+#[derive(Debug)]
+pub struct QuadTopology {
+    asm: Assembly<4>,
+    base: Vec<DVec2>,
+    alpha_bar: f64,
+}
+
+impl QuadTopology {
+    /// From any mesh implementing the traits (structured grid, merged block mesh, file mesh).
+    /// Node coordinates are copied: the fixed ones are the data of the problem, the free ones
+    /// give [`initial_x`](Self::initial_x).
+    pub fn from_mesh<M: HasQuadCells + FreeNodes + ?Sized>(
+        mesh: &M,
+    ) -> Result<Self, FunctionalError> {
+        let n = mesh.num_nodes();
+        if mesh.num_flagged_nodes() != n {
+            return Err(FunctionalError::LengthMismatch {
+                what: "fixed flags",
+                got: mesh.num_flagged_nodes(),
+                expected: n,
+            });
+        }
+        let cells: Vec<[usize; 4]> = (0..mesh.num_quads()).map(|c| mesh.quad(c)).collect();
+        let fixed: Vec<bool> = (0..n).map(|v| mesh.is_fixed(v)).collect();
+        Self::new(mesh.nodes().to_vec(), cells, fixed)
+    }
+
+    /// From raw arrays: node coordinates, counter-clockwise cells and one fixed flag per node.
+    pub fn new(
+        nodes: Vec<DVec2>,
+        cells: Vec<[usize; 4]>,
+        fixed: Vec<bool>,
+    ) -> Result<Self, FunctionalError> {
+        if fixed.len() != nodes.len() {
+            return Err(FunctionalError::LengthMismatch {
+                what: "fixed flags",
+                got: fixed.len(),
+                expected: nodes.len(),
+            });
+        }
+        if let Some(v) = nodes.iter().position(|p| !p.is_finite()) {
+            return Err(FunctionalError::NonFinite { node: v });
+        }
+        let asm = Assembly::new(nodes.len(), cells, |v| fixed[v])?;
+        let mut t = Self {
+            asm,
+            base: nodes,
+            alpha_bar: 0.0,
+        };
+        let x = t.initial_x();
+        t.alpha_bar = t.alpha_summary(&x).mean;
+        Ok(t)
+    }
+
+    /// Number of mesh nodes.
+    pub fn num_nodes(&self) -> usize {
+        self.asm.num_nodes
+    }
+    /// Number of cells.
+    pub fn num_cells(&self) -> usize {
+        self.asm.num_cells()
+    }
+    /// Number of corner triangles `N = 4 · cells`.
+    pub fn num_triangles(&self) -> usize {
+        4 * self.asm.num_cells()
+    }
+    /// Number of variables (2 per free node).
+    pub fn num_vars(&self) -> usize {
+        2 * self.asm.free.len()
+    }
+    /// Mesh node ids of the free nodes, increasing.
+    pub fn free_nodes(&self) -> &[usize] {
+        &self.asm.free
+    }
+    /// Variable-node index of `node` (`x[2j]`, `x[2j+1]` are its coordinates).
+    pub fn var_of(&self, node: usize) -> Option<usize> {
+        match self.asm.var_of.get(node) {
+            Some(&v) if v != FIXED => Some(v as usize),
+            _ => None,
+        }
+    }
+    /// Node ids of cell `c`.
+    pub fn cell(&self, c: usize) -> [usize; 4] {
+        self.asm.cells[c].map(|v| v as usize)
+    }
+    /// Number of colours of the parallel schedule (1 = fully parallel chunks).
+    pub fn num_colors(&self) -> usize {
+        self.asm.colors.len()
+    }
+    /// `ᾱ = Σα/N` of the mesh given at construction (`= 4·area(Ω)/N` for a mesh with fixed
+    /// boundary; independent of the interior nodes, seed 001 digest §1).
+    pub fn alpha_bar(&self) -> f64 {
+        self.alpha_bar
+    }
+    /// The coordinates of all nodes stored in the topology (fixed nodes are the data; free
+    /// nodes hold the values given at construction or by [`set_coords`](Self::set_coords)).
+    pub fn coords(&self) -> &[DVec2] {
+        &self.base
+    }
+    /// Replaces the stored coordinates (fixed-node data and initial free positions).
+    pub fn set_coords(&mut self, nodes: &[DVec2]) -> Result<(), FunctionalError> {
+        if nodes.len() != self.base.len() {
+            return Err(FunctionalError::LengthMismatch {
+                what: "node coordinates",
+                got: nodes.len(),
+                expected: self.base.len(),
+            });
+        }
+        self.base.copy_from_slice(nodes);
+        Ok(())
+    }
+    /// The variable vector of the stored coordinates.
+    pub fn initial_x(&self) -> Vec<f64> {
+        let mut x = vec![0.0; self.num_vars()];
+        self.gather_into(&self.base, &mut x);
+        x
+    }
+    /// The variable vector of mesh coordinates `nodes` (one per mesh node).
+    pub fn gather(&self, nodes: &[DVec2]) -> Vec<f64> {
+        let mut x = vec![0.0; self.num_vars()];
+        self.gather_into(nodes, &mut x);
+        x
+    }
+    /// Writes the free-node coordinates of `nodes` into `x`.
+    ///
+    /// # Panics
+    /// If `nodes` has fewer entries than the mesh or `x.len() != num_vars()`.
+    pub fn gather_into(&self, nodes: &[DVec2], x: &mut [f64]) {
+        assert_eq!(x.len(), self.num_vars(), "gather: x has the wrong length");
+        for (j, &v) in self.asm.free.iter().enumerate() {
+            x[2 * j] = nodes[v].x;
+            x[2 * j + 1] = nodes[v].y;
+        }
+    }
+    /// Writes `x` into the free nodes of `nodes` (fixed nodes untouched).
+    ///
+    /// # Panics
+    /// If `nodes` has fewer entries than the mesh or `x.len() != num_vars()`.
+    pub fn scatter(&self, x: &[f64], nodes: &mut [DVec2]) {
+        assert_eq!(x.len(), self.num_vars(), "scatter: x has the wrong length");
+        for (j, &v) in self.asm.free.iter().enumerate() {
+            nodes[v] = DVec2::new(x[2 * j], x[2 * j + 1]);
+        }
+    }
+    /// All node coordinates for `x` (fixed nodes from the stored data).
+    pub fn node_coords(&self, x: &[f64]) -> Vec<DVec2> {
+        let mut n = self.base.clone();
+        self.scatter(x, &mut n);
+        n
+    }
+
+    /// Points of cell `c` and the variable-node index of each vertex ([`FIXED`] if fixed).
+    #[inline(always)]
+    fn cell_points(&self, x: &[f64], c: usize) -> ([DVec2; 4], [u32; 4]) {
+        let src = self.asm.src[c];
+        let mut p = [DVec2::ZERO; 4];
+        let mut vars = [FIXED; 4];
+        for i in 0..4 {
+            let s = src[i];
+            if s & FIXED_BIT == 0 {
+                let j = 2 * s as usize;
+                p[i] = DVec2::new(x[j], x[j + 1]);
+                vars[i] = s;
+            } else {
+                p[i] = self.base[(s & !FIXED_BIT) as usize];
+            }
+        }
+        (p, vars)
+    }
+
+    /// α of every corner triangle at `x` (`out[4c + k]`, corner `k` of cell `c`).
+    ///
+    /// # Panics
+    /// If `out.len() != num_triangles()` or `x.len() != num_vars()`.
+    pub fn alphas(&self, x: &[f64], out: &mut [f64]) {
+        assert_eq!(
+            out.len(),
+            self.num_triangles(),
+            "alphas: out has the wrong length"
+        );
+        assert_eq!(x.len(), self.num_vars(), "alphas: x has the wrong length");
+        out.par_chunks_mut(4).enumerate().for_each(|(c, o)| {
+            let (p, _) = self.cell_points(x, c);
+            for k in 0..4 {
+                o[k] = (p[(k + 1) & 3] - p[k]).perp_dot(p[(k + 3) & 3] - p[k]);
+            }
+        });
+    }
+
+    /// `α₋`, `ᾱ` and non-convex counts at `x`.
+    pub fn alpha_summary(&self, x: &[f64]) -> AlphaSummary {
+        let mut a = vec![0.0; self.num_triangles()];
+        self.alphas(x, &mut a);
+        let mut s = AlphaSummary {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            mean: 0.0,
+            nonpositive_triangles: 0,
+            nonconvex_cells: 0,
+        };
+        let mut sum = 0.0;
+        for cell in a.chunks(4) {
+            let mut bad = false;
+            for &v in cell {
+                s.min = s.min.min(v);
+                s.max = s.max.max(v);
+                sum += v;
+                if v <= 0.0 {
+                    s.nonpositive_triangles += 1;
+                    bad = true;
+                }
+            }
+            s.nonconvex_cells += bad as usize;
+        }
+        s.mean = sum / a.len() as f64;
+        s
+    }
+
+    /// Per-cell density weights for seed 000 (6.9): `density` on the cells within `layers` cell
+    /// layers of the mesh boundary (layer 1 = cells touching a boundary node, where boundary
+    /// nodes are those on edges used by one cell), 1 elsewhere. The thesis uses an integer
+    /// density below 10 and does not give the band width.
+    pub fn boundary_density(&self, density: f64, layers: usize) -> Vec<f64> {
+        let n = self.asm.num_nodes;
+        let mut edges: std::collections::HashMap<(u32, u32), u32> =
+            std::collections::HashMap::new();
+        for cell in &self.asm.cells {
+            for k in 0..4 {
+                let (a, b) = (cell[k], cell[(k + 1) & 3]);
+                *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let mut near = vec![false; n];
+        for ((a, b), cnt) in edges {
+            if cnt == 1 {
+                near[a as usize] = true;
+                near[b as usize] = true;
+            }
+        }
+        let mut w = vec![1.0; self.num_cells()];
+        for _ in 0..layers {
+            let mut hit = Vec::new();
+            for (c, cell) in self.asm.cells.iter().enumerate() {
+                if cell.iter().any(|&v| near[v as usize]) {
+                    w[c] = density;
+                    hit.push(c);
+                }
+            }
+            for c in hit {
+                for &v in &self.asm.cells[c] {
+                    near[v as usize] = true;
+                }
+            }
+        }
+        w
+    }
+
+    /// The Hessian sparsity pattern (2×2 blocks for every pair of free nodes sharing a cell).
+    pub fn hessian_pattern(&self) -> Csr {
+        Csr::from_block_pattern(2, &self.asm.nbr_offsets, &self.asm.nbr)
+    }
+}
+
+#[inline(always)]
+fn scalars(p: &[DVec2; 4], c: usize, k: usize) -> (DVec2, DVec2, TriScalars) {
+    let l = LEGS[k];
+    let a = p[l[1]] - p[l[0]];
+    let b = p[l[3]] - p[l[2]];
+    (
+        a,
+        b,
+        TriScalars {
+            alpha: a.perp_dot(b),
+            la: a.length_squared(),
+            lb: b.length_squared(),
+            o: a.dot(b),
+            cell: c,
+            corner: k as u8,
+        },
+    )
+}
+
+#[inline(always)]
+fn pair_range(t: Terms) -> (usize, usize) {
+    match (t.corners, t.diagonal) {
+        (true, true) => (0, 5),
+        (true, false) => (0, 4),
+        (false, true) => (4, 5),
+        (false, false) => (0, 0),
+    }
+}
+
+/// Corner-triangle scalars from the cell edges `e_k = v_{k+1} − v_k`: at corner `k`,
+/// `a = e_k`, `b = −e_{k−1}` (bitwise identical to `v_{k−1} − v_k`).
+#[inline(always)]
+fn corner_from_edges(
+    e: &[DVec2; 4],
+    l2: &[f64; 4],
+    c: usize,
+    k: usize,
+) -> (DVec2, DVec2, TriScalars) {
+    let km = (k + 3) & 3;
+    let a = e[k];
+    let b = -e[km];
+    (
+        a,
+        b,
+        TriScalars {
+            alpha: a.perp_dot(b),
+            la: l2[k],
+            lb: l2[km],
+            o: a.dot(b),
+            cell: c,
+            corner: k as u8,
+        },
+    )
+}
+
+#[inline(always)]
+fn edges(p: &[DVec2; 4]) -> ([DVec2; 4], [f64; 4]) {
+    let e = [p[1] - p[0], p[2] - p[1], p[3] - p[2], p[0] - p[3]];
+    (e, e.map(|v| v.length_squared()))
+}
+
+#[inline(always)]
+fn cell_value<K: TriKernel>(k: &K, t: Terms, p: &[DVec2; 4], c: usize) -> f64 {
+    let mut v = 0.0;
+    if t.corners {
+        let (e, l2) = edges(p);
+        for q in 0..4 {
+            let (_, _, s) = corner_from_edges(&e, &l2, c, q);
+            v += k.value(&s);
+        }
+    }
+    if t.diagonal {
+        let (_, _, s) = scalars(p, c, 4);
+        v += k.value(&s);
+    }
+    v
+}
+
+#[inline(always)]
+fn leg_grads(a: DVec2, b: DVec2, d: &[f64; 4]) -> (DVec2, DVec2) {
+    let ga = d[0] * DVec2::new(b.y, -b.x) + (2.0 * d[1]) * a + d[3] * b;
+    let gb = d[0] * DVec2::new(-a.y, a.x) + (2.0 * d[2]) * b + d[3] * a;
+    (ga, gb)
+}
+
+/// Value and gradient of the terms of cell `c` (corner terms accumulated per edge, then per
+/// node: `e_k = v_{k+1} − v_k` gives `+∂f/∂e_k` to `v_{k+1}` and `−∂f/∂e_k` to `v_k`).
+#[inline(always)]
+fn cell_grad<K: TriKernel>(k: &K, t: Terms, p: &[DVec2; 4], c: usize, g: &mut [DVec2; 4]) -> f64 {
+    let mut v = 0.0;
+    if t.corners {
+        let (e, l2) = edges(p);
+        let mut ge = [DVec2::ZERO; 4];
+        for q in 0..4 {
+            let (a, b, s) = corner_from_edges(&e, &l2, c, q);
+            let (val, dg) = k.value_grad(&s);
+            v += val;
+            let (ga, gb) = leg_grads(a, b, &dg);
+            ge[q] += ga;
+            ge[(q + 3) & 3] -= gb;
+        }
+        for q in 0..4 {
+            g[(q + 1) & 3] += ge[q];
+            g[q] -= ge[q];
+        }
+    }
+    if t.diagonal {
+        let (a, b, s) = scalars(p, c, 4);
+        let (val, dg) = k.value_grad(&s);
+        v += val;
+        let (ga, gb) = leg_grads(a, b, &dg);
+        let l = LEGS[4];
+        g[l[1]] += ga;
+        g[l[0]] -= ga;
+        g[l[3]] += gb;
+        g[l[2]] -= gb;
+    }
+    v
+}
+
+/// Value, gradient and 8×8 Hessian of the terms of cell `c`; with `only = Some(i)` the corner
+/// triangle not containing local node `i` is skipped.
+#[inline(always)]
+fn cell_hess<K: TriKernel>(
+    k: &K,
+    t: Terms,
+    p: &[DVec2; 4],
+    c: usize,
+    only: Option<usize>,
+    g: &mut [DVec2; 4],
+    h: &mut [[f64; 8]; 8],
+) -> f64 {
+    let (lo, hi) = pair_range(t);
+    let mut v = 0.0;
+    for q in lo..hi {
+        if let Some(i) = only {
+            if q < 4 && q == (i + 2) & 3 {
+                continue;
+            }
+        }
+        let (a, b, s) = scalars(p, c, q);
+        let d = k.eval(&s, Order::Hessian);
+        v += d.v;
+        let (ga, gb) = leg_grads(a, b, &d.g);
+        let l = LEGS[q];
+        g[l[1]] += ga;
+        g[l[0]] -= ga;
+        g[l[3]] += gb;
+        g[l[2]] -= gb;
+        // J = ∂s/∂u, u = (ax, ay, bx, by)
+        let j = [
+            [b.y, -b.x, -a.y, a.x],
+            [2.0 * a.x, 2.0 * a.y, 0.0, 0.0],
+            [0.0, 0.0, 2.0 * b.x, 2.0 * b.y],
+            [b.x, b.y, a.x, a.y],
+        ];
+        let mut hj = [[0.0; 4]; 4]; // (∂²f/∂s²) J
+        for si in 0..4 {
+            for ui in 0..4 {
+                let mut acc = 0.0;
+                for tt in 0..4 {
+                    acc += d.h[si][tt] * j[tt][ui];
+                }
+                hj[si][ui] = acc;
+            }
+        }
+        let mut hu = [[0.0; 4]; 4];
+        for ui in 0..4 {
+            for uj in 0..4 {
+                let mut acc = 0.0;
+                for si in 0..4 {
+                    acc += j[si][ui] * hj[si][uj];
+                }
+                hu[ui][uj] = acc;
+            }
+        }
+        let (ga_, gla, glb, go) = (d.g[0], d.g[1], d.g[2], d.g[3]);
+        hu[0][3] += ga_;
+        hu[3][0] += ga_;
+        hu[1][2] -= ga_;
+        hu[2][1] -= ga_;
+        hu[0][0] += 2.0 * gla;
+        hu[1][1] += 2.0 * gla;
+        hu[2][2] += 2.0 * glb;
+        hu[3][3] += 2.0 * glb;
+        hu[0][2] += go;
+        hu[2][0] += go;
+        hu[1][3] += go;
+        hu[3][1] += go;
+        // (node, sign, leg)
+        let ends = [
+            (l[1], 1.0, 0usize),
+            (l[0], -1.0, 0),
+            (l[3], 1.0, 1),
+            (l[2], -1.0, 1),
+        ];
+        for &(ni, si, li) in &ends {
+            for &(nj, sj, lj) in &ends {
+                let sg = si * sj;
+                for dx in 0..2 {
+                    for dy in 0..2 {
+                        h[2 * ni + dx][2 * nj + dy] += sg * hu[2 * li + dx][2 * lj + dy];
+                    }
+                }
+            }
+        }
+    }
+    v
+}
+
+/// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a per-term kernel.
+#[derive(Debug, Clone)]
+pub struct QuadFunctional<K> {
+    topo: Arc<QuadTopology>,
+    kernel: K,
+    terms: Terms,
+}
+
+impl<K: TriKernel> QuadFunctional<K> {
+    /// The functional `Σ kernel` over the leg pairs of the topology.
+    pub fn new(topo: Arc<QuadTopology>, kernel: K) -> Self {
+        let terms = kernel.terms();
+        Self {
+            topo,
+            kernel,
+            terms,
+        }
+    }
+    /// The topology.
+    pub fn topology(&self) -> &Arc<QuadTopology> {
+        &self.topo
+    }
+    /// The kernel.
+    pub fn kernel(&self) -> &K {
+        &self.kernel
+    }
+    /// Replaces the kernel (e.g. a new ω or k during a continuation), keeping the topology.
+    pub fn set_kernel(&mut self, kernel: K) {
+        self.terms = kernel.terms();
+        self.kernel = kernel;
+    }
+    /// The value with a single-threaded loop (same chunked summation as [`Problem::value`], so
+    /// the results are identical); useful as a reference.
+    pub fn value_serial(&self, x: &[f64]) -> f64 {
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "value: x has the wrong length"
+        );
+        self.topo.asm.run_serial_sum(|c| {
+            let (p, _) = self.topo.cell_points(x, c);
+            cell_value(&self.kernel, self.terms, &p, c)
+        })
+    }
+}
+
+impl<K: TriKernel> Problem for QuadFunctional<K> {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_vars(&self) -> usize {
+        self.topo.num_vars()
+    }
+    fn free_nodes(&self) -> &[usize] {
+        self.topo.free_nodes()
+    }
+    fn var_of(&self, node: usize) -> Option<usize> {
+        self.topo.var_of(node)
+    }
+
+    fn value(&self, x: &[f64]) -> f64 {
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "value: x has the wrong length"
+        );
+        self.topo.asm.run_value(|c| {
+            let (p, _) = self.topo.cell_points(x, c);
+            cell_value(&self.kernel, self.terms, &p, c)
+        })
+    }
+
+    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "value_grad: x has the wrong length"
+        );
+        assert_eq!(
+            g.len(),
+            self.topo.num_vars(),
+            "value_grad: g has the wrong length"
+        );
+        g.par_iter_mut().with_min_len(4096).for_each(|v| *v = 0.0);
+        let gp = SyncPtr::new(g);
+        self.topo.asm.run_colored(|c| {
+            let (p, vars) = self.topo.cell_points(x, c);
+            let mut lg = [DVec2::ZERO; 4];
+            let v = cell_grad(&self.kernel, self.terms, &p, c, &mut lg);
+            for i in 0..4 {
+                let j = vars[i];
+                if j != FIXED {
+                    let j = 2 * j as usize;
+                    // SAFETY: node of this cell; see `assembly` (colouring).
+                    unsafe {
+                        gp.add(j, lg[i].x);
+                        gp.add(j + 1, lg[i].y);
+                    }
+                }
+            }
+            v
+        })
+    }
+
+    fn hessian_pattern(&self) -> Csr {
+        self.topo.hessian_pattern()
+    }
+
+    fn hessian(&self, x: &[f64], h: &mut Csr) {
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "hessian: x has the wrong length"
+        );
+        assert_eq!(
+            h.nrows,
+            self.topo.num_vars(),
+            "hessian: matrix has the wrong size"
+        );
+        assert!(
+            self.topo.asm.matches_pattern(2, h),
+            "hessian: matrix does not come from hessian_pattern"
+        );
+        let Csr {
+            row_offsets,
+            values,
+            ..
+        } = h;
+        values
+            .par_iter_mut()
+            .with_min_len(4096)
+            .for_each(|v| *v = 0.0);
+        let hp = SyncPtr::new(values);
+        let ro: &[usize] = row_offsets;
+        let asm = &self.topo.asm;
+        asm.run_colored(|c| {
+            let (p, vars) = self.topo.cell_points(x, c);
+            let mut lg = [DVec2::ZERO; 4];
+            let mut lh = [[0.0; 8]; 8];
+            cell_hess(&self.kernel, self.terms, &p, c, None, &mut lg, &mut lh);
+            for i in 0..4 {
+                let vi = vars[i];
+                if vi == FIXED {
+                    continue;
+                }
+                for jn in 0..4 {
+                    let vj = vars[jn];
+                    if vj == FIXED {
+                        continue;
+                    }
+                    let k = asm.nbr_pos(vi, vj);
+                    for dx in 0..2 {
+                        let base = ro[2 * vi as usize + dx] + 2 * k;
+                        // SAFETY: row of a node of this cell; see `assembly` (colouring).
+                        unsafe {
+                            hp.add(base, lh[2 * i + dx][2 * jn]);
+                            hp.add(base + 1, lh[2 * i + dx][2 * jn + 1]);
+                        }
+                    }
+                }
+            }
+            0.0
+        });
+    }
+
+    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+        let n = self.topo.num_vars();
+        assert_eq!(x.len(), n, "hess_vec: x has the wrong length");
+        assert_eq!(v.len(), n, "hess_vec: v has the wrong length");
+        assert_eq!(out.len(), n, "hess_vec: out has the wrong length");
+        out.par_iter_mut().with_min_len(4096).for_each(|o| *o = 0.0);
+        let op = SyncPtr::new(out);
+        self.topo.asm.run_colored(|c| {
+            let (p, vars) = self.topo.cell_points(x, c);
+            let mut lg = [DVec2::ZERO; 4];
+            let mut lh = [[0.0; 8]; 8];
+            cell_hess(&self.kernel, self.terms, &p, c, None, &mut lg, &mut lh);
+            let mut lv = [0.0; 8];
+            for i in 0..4 {
+                if vars[i] != FIXED {
+                    let j = 2 * vars[i] as usize;
+                    lv[2 * i] = v[j];
+                    lv[2 * i + 1] = v[j + 1];
+                }
+            }
+            for i in 0..4 {
+                if vars[i] == FIXED {
+                    continue;
+                }
+                let j = 2 * vars[i] as usize;
+                for dx in 0..2 {
+                    let mut acc = 0.0;
+                    for (col, &vv) in lv.iter().enumerate() {
+                        acc += lh[2 * i + dx][col] * vv;
+                    }
+                    // SAFETY: node of this cell; see `assembly` (colouring).
+                    unsafe { op.add(j + dx, acc) };
+                }
+            }
+            0.0
+        });
+    }
+
+    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
+        self.topo.var_of(node)?;
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "local: x has the wrong length"
+        );
+        let asm = &self.topo.asm;
+        let mut m = LocalModel {
+            value: 0.0,
+            grad: [0.0; 3],
+            hess: [[0.0; 3]; 3],
+            dim: 2,
+        };
+        for &c in &asm.inc[asm.inc_offsets[node]..asm.inc_offsets[node + 1]] {
+            let c = c as usize;
+            let i = asm.cells[c].iter().position(|&v| v as usize == node)?;
+            let (p, _) = self.topo.cell_points(x, c);
+            let mut lg = [DVec2::ZERO; 4];
+            let mut lh = [[0.0; 8]; 8];
+            m.value += cell_hess(&self.kernel, self.terms, &p, c, Some(i), &mut lg, &mut lh);
+            m.grad[0] += lg[i].x;
+            m.grad[1] += lg[i].y;
+            for dx in 0..2 {
+                for dy in 0..2 {
+                    m.hess[dx][dy] += lh[2 * i + dx][2 * i + dy];
+                }
+            }
+        }
+        Some(m)
+    }
+
+    fn num_elements(&self) -> usize {
+        self.topo.num_triangles()
+    }
+
+    fn element_measures(&self, x: &[f64], out: &mut [f64]) {
+        self.topo.alphas(x, out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernels2::DIAGONAL;
+
+    #[test]
+    fn diagonal_pair_gives_twice_the_cell_area() {
+        let p = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(2.0, 0.0),
+            DVec2::new(2.0, 3.0),
+            DVec2::new(0.0, 3.0),
+        ];
+        let (_, _, s) = scalars(&p, 0, DIAGONAL as usize);
+        assert!((s.alpha - 12.0).abs() < 1e-12);
+        let (_, _, s0) = scalars(&p, 0, 0);
+        assert!((s0.alpha - 6.0).abs() < 1e-12);
+        assert!((s0.la - 4.0).abs() < 1e-12 && (s0.lb - 9.0).abs() < 1e-12);
+    }
+}
