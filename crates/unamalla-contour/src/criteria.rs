@@ -1,0 +1,139 @@
+//! Triangle measures behind every criterion of seed 000 §3.3 (digest §2.4–§2.5).
+//!
+//! For a vertex `b` with ring neighbours `a` (previous) and `c` (next) the triangle is
+//! `T = (a, b, c)`, with side lengths `ℓ₁ = |b − a|`, `ℓ₂ = |c − b|`, `ℓ₃ = |c − a|`, perimeter
+//! `p = ℓ₁ + ℓ₂ + ℓ₃`, doubled signed area `α = det(b − a, c − a)` (computed with the exact-sign
+//! predicate, so exactly collinear vertices give exactly `0`) and interior angle `θ` at `b`.
+//! Closed forms used (no trigonometry):
+//!
+//! * `|sin θ| = |α| / (ℓ₁ ℓ₂)`;
+//! * weighted area (3.4): `ζ = |α| · |sin θ| = α² / (ℓ₁ ℓ₂)`;
+//! * in/circumradius ratio (§3.3.2): `r = |α| / p`, `R = ℓ₁ℓ₂ℓ₃ / (2|α|)`, so
+//!   `r / R = 2 α² / (p ℓ₁ ℓ₂ ℓ₃)` ∈ `[0, 1/2]`;
+//! * modified radius metric (3.7): `ρ = 2 r R |sin θ| = (ℓ₁ℓ₂ℓ₃ / p) · |α| / (ℓ₁ℓ₂) = ℓ₃ |α| / p`
+//!   (erratum 6: `|sin θ|`).
+
+use glam::DVec2;
+use unamalla_mesh::geometry::orient2d;
+
+/// `|α|`, the doubled (unsigned) area of triangle `abc`; exactly `0` iff collinear.
+#[inline]
+pub fn doubled_area(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    orient2d(a, b, c).abs()
+}
+
+/// Area of triangle `abc` (Visvalingam's effective area, §3.1.1).
+#[inline]
+pub fn triangle_area(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    0.5 * doubled_area(a, b, c)
+}
+
+/// `|sin θ|` of the angle at `b` between `ba` and `bc`; `0` if either side is degenerate.
+#[inline]
+pub fn sin_angle(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let l1l2 = a.distance(b) * c.distance(b);
+    if l1l2 > 0.0 {
+        (doubled_area(a, b, c) / l1l2).min(1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Weighted area ζ = α·|sin θ| (eq. 3.4), α the doubled area and θ the angle at `b`.
+#[inline]
+pub fn weighted_area(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let al = doubled_area(a, b, c);
+    let l1l2 = a.distance(b) * c.distance(b);
+    if l1l2 > 0.0 {
+        al * al / l1l2
+    } else {
+        0.0
+    }
+}
+
+/// Ratio r/R of inradius to circumradius of triangle `abc` (§3.3.2): `1/2` for an
+/// equilateral triangle, `0` for a degenerate one.
+#[inline]
+pub fn radius_ratio(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let (l1, l2, l3) = (a.distance(b), c.distance(b), c.distance(a));
+    let den = (l1 + l2 + l3) * l1 * l2 * l3;
+    if den > 0.0 {
+        let al = doubled_area(a, b, c);
+        2.0 * al * al / den
+    } else {
+        0.0
+    }
+}
+
+/// Modified radius metric ρ = 2 r R |sin θ| (eq. 3.7) with `2rR = ℓ₁ℓ₂ℓ₃/(ℓ₁+ℓ₂+ℓ₃)`.
+#[inline]
+pub fn modified_radius(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    let (l1, l2, l3) = (a.distance(b), c.distance(b), c.distance(a));
+    let p = l1 + l2 + l3;
+    if p > 0.0 {
+        l3 * doubled_area(a, b, c) / p
+    } else {
+        0.0
+    }
+}
+
+/// Mean triangle area ā = (1/n) Σ area(v_{i−1}, v_i, v_{i+1}) over a cyclic ring (the
+/// normalisation of (3.3), (3.5), (3.6), (3.8)).
+pub fn mean_triangle_area(ring: &[DVec2]) -> f64 {
+    let n = ring.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let s: f64 = (0..n)
+        .map(|i| triangle_area(ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]))
+        .sum();
+    s / n as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64) -> DVec2 {
+        DVec2::new(x, y)
+    }
+
+    #[test]
+    fn equilateral_and_right_triangles() {
+        let (a, b, c) = (v(0., 0.), v(0.5, 3f64.sqrt() / 2.), v(1., 0.));
+        assert!((radius_ratio(a, b, c) - 0.5).abs() < 1e-12);
+        // Carnot: r/R = cos A + cos B + cos C − 1 = 3/2 − 1
+        // right isosceles, legs 1: r = (2 − √2)/2, R = √2/2
+        let (a, b, c) = (v(1., 0.), v(0., 0.), v(0., 1.));
+        let r = (2.0 - 2f64.sqrt()) / 2.0;
+        let rr = 2f64.sqrt() / 2.0;
+        assert!((radius_ratio(a, b, c) - r / rr).abs() < 1e-12);
+        // angle at b is 90°: ζ = α·1 = 1, ρ = 2 r R = 2·r·R
+        assert!((weighted_area(a, b, c) - 1.0).abs() < 1e-12);
+        assert!((modified_radius(a, b, c) - 2.0 * r * rr).abs() < 1e-12);
+        assert!((sin_angle(a, b, c) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn collinear_is_exactly_zero() {
+        let (a, b, c) = (v(0.1, 0.1), v(0.2, 0.2), v(0.7, 0.7));
+        assert_eq!(weighted_area(a, b, c), 0.0);
+        assert_eq!(radius_ratio(a, b, c), 0.0);
+        assert_eq!(modified_radius(a, b, c), 0.0);
+        assert_eq!(triangle_area(a, b, c), 0.0);
+    }
+
+    #[test]
+    fn weighted_area_uses_sine_of_the_angle_at_b() {
+        // angle 30° at b, sides 2 and 3: α = 2·3·sin30 = 3, ζ = 3·0.5
+        let b = v(0., 0.);
+        let a = v(2., 0.);
+        let t = 30f64.to_radians();
+        let c = v(3. * t.cos(), 3. * t.sin());
+        assert!((weighted_area(a, b, c) - 1.5).abs() < 1e-12);
+        // 2rR = ℓ1ℓ2ℓ3/p
+        let l3 = a.distance(c);
+        let expect = 2.0 * 3.0 * l3 / (5.0 + l3) * 0.5;
+        assert!((modified_radius(a, b, c) - expect).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,585 @@
+//! The region-level driver: [`Method`], [`SimplifyOptions`], [`simplify_region`] and its
+//! [`SimplifyResult`].
+
+use std::fmt;
+use std::str::FromStr;
+use std::time::{Duration, Instant};
+
+use glam::DVec2;
+use rayon::prelude::*;
+use rstar::primitives::{GeomWithData, Rectangle};
+use rstar::{RTree, AABB};
+use serde::{Deserialize, Serialize};
+use unamalla_mesh::geometry::{orient2d, point_segment_distance};
+use unamalla_mesh::{Region, RingId, SegmentIndex};
+
+use crate::criteria::{
+    mean_triangle_area, modified_radius, radius_ratio, triangle_area, weighted_area,
+};
+use crate::error::ContourError;
+use crate::mpp::{minimum_perimeter_polygon, MppOptions};
+use crate::removal::{batch, sequential, Stop, Workspace};
+
+/// A simplification method of seed 000 ch. 3 (names as accepted by [`Method::from_str`]).
+///
+/// Default thresholds ([`Method::default_epsilon`], [`Method::default_delta`]):
+///
+/// | method | name | `ε` clean | `ε` noisy | `δ` clean | `δ` noisy | source |
+/// |---|---|---|---|---|---|---|
+/// | [`Method::Visvalingam`] | `visvalingam` | 1 | 20 | – | – | Tables 3.1–3.3 |
+/// | [`Method::Areas`] | `areas` | 1e-4 | 1e-2 | – | – | §3.3.3 step 1; Obs 3.3 range 1e-4..1e-2 |
+/// | [`Method::Radii`] | `radii` | 1e-4 | 1e-2 | – | – | §3.3.3 step 3; Obs 3.3 |
+/// | [`Method::ModifiedAreas`] | `modified-areas` | 1 | 20 | – | – | Tables 3.1–3.3 |
+/// | [`Method::ModifiedRadii`] | `modified-radii` | 1 | 20 | – | – | Tables 3.1–3.3, Obs 3.4 |
+/// | [`Method::ThreeStep`] | `three-step` | 1e-4 | 1e-4 | 1e-4 | 1e-3 | §3.3.3 |
+/// | [`Method::ModifiedThreeStep`] | `modified-three-step` | 0.1 | 3 | 1e-5 | 1e-4 | §3.3.4 presets, Table 3.1 |
+///
+/// For the three-step methods `ε` is the threshold of the last step (ρ for `three-step`);
+/// their first step always uses the thesis's fixed value (1e-4, resp. 0.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Scaled Visvalingam (§3.1.1, Obs 3.1): repeatedly remove the vertex of smallest triangle
+    /// area while that area is below `ε · ā`, `ā` the mean triangle area of the input ring
+    /// (fixed: with the mean of the *current* ring every `ε ≥ 1` would remove vertices down to
+    /// a triangle, since the minimum never exceeds the mean, contradicting the thesis's use of
+    /// ε = 1 and ε = 20 in Tables 3.1–3.3).
+    Visvalingam,
+    /// Area criterion (3.5), batch passes: remove all `v_i` with `ζ_i / ā < 2ε`,
+    /// `ζ_i = α_i |sin θ_i|`, `ā` the current mean triangle area; repeat until stable.
+    Areas,
+    /// Radius criterion (§3.3.2), batch passes: remove all `v_i` with `r_i / R_i < ε`.
+    Radii,
+    /// Modified area criterion (3.6): one vertex at a time, the one of smallest `ζ`, while
+    /// `ζ < ᾱ ε` with `ᾱ` the mean triangle area of the input ring (fixed).
+    #[default]
+    ModifiedAreas,
+    /// Modified radius criterion (3.7)/(3.8): like [`Method::ModifiedAreas`] with
+    /// `ρ = 2 r R |sin θ|`.
+    ModifiedRadii,
+    /// Three-step method (§3.3.3): areas (ε = 1e-4) → minimum-perimeter polygon (δ) → radii (ε).
+    ThreeStep,
+    /// Modified three-step method (§3.3.4): modified areas (ε = 0.1) → minimum-perimeter
+    /// polygon (δ) → modified areas (ε); `ᾱ` of both removal steps is that of the input ring.
+    ModifiedThreeStep,
+}
+
+impl Method {
+    /// Every method, in the order of the thesis.
+    pub const ALL: [Method; 7] = [
+        Method::Visvalingam,
+        Method::Areas,
+        Method::Radii,
+        Method::ModifiedAreas,
+        Method::ModifiedRadii,
+        Method::ThreeStep,
+        Method::ModifiedThreeStep,
+    ];
+    /// The accepted names, in the order of [`Method::ALL`].
+    pub const NAMES: [&'static str; 7] = [
+        "visvalingam",
+        "areas",
+        "radii",
+        "modified-areas",
+        "modified-radii",
+        "three-step",
+        "modified-three-step",
+    ];
+
+    /// The method's name (as accepted by [`Method::from_str`]).
+    pub fn name(self) -> &'static str {
+        Self::NAMES[Self::ALL.iter().position(|&m| m == self).unwrap_or(0)]
+    }
+
+    /// `true` for the methods that move points (they run the minimum-perimeter polygon); the
+    /// others return a subset of the input vertices in their original order.
+    pub fn moves_points(self) -> bool {
+        matches!(self, Method::ThreeStep | Method::ModifiedThreeStep)
+    }
+
+    /// Default threshold `ε` for a preset (table in the type documentation).
+    pub fn default_epsilon(self, preset: Preset) -> f64 {
+        let noisy = preset == Preset::Noisy;
+        match self {
+            Method::Visvalingam | Method::ModifiedAreas | Method::ModifiedRadii => {
+                if noisy {
+                    20.0
+                } else {
+                    1.0
+                }
+            }
+            Method::Areas | Method::Radii => {
+                if noisy {
+                    1e-2
+                } else {
+                    1e-4
+                }
+            }
+            Method::ThreeStep => 1e-4,
+            Method::ModifiedThreeStep => {
+                if noisy {
+                    3.0
+                } else {
+                    0.1
+                }
+            }
+        }
+    }
+
+    /// Default MPP factor `δ` for a preset, `None` for methods without the MPP step.
+    pub fn default_delta(self, preset: Preset) -> Option<f64> {
+        let noisy = preset == Preset::Noisy;
+        match self {
+            Method::ThreeStep => Some(if noisy { 1e-3 } else { 1e-4 }),
+            Method::ModifiedThreeStep => Some(if noisy { 1e-4 } else { 1e-5 }),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = ContourError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::NAMES
+            .iter()
+            .position(|&n| n == s)
+            .map(|k| Self::ALL[k])
+            .ok_or_else(|| ContourError::UnknownMethod {
+                name: s.to_string(),
+                valid: Self::NAMES.join(", "),
+            })
+    }
+}
+
+/// Which set of default thresholds to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// No noise: simplification thresholds (e.g. modified three-step δ = 1e-5, ε = 0.1).
+    #[default]
+    Clean,
+    /// Noise suppression (e.g. modified three-step δ = 1e-4, ε = 3).
+    Noisy,
+    /// Decide per region with [`crate::noise::detect_noise_region`].
+    Auto,
+}
+
+/// Which holes to drop before simplifying (the thesis recommends removing negligible holes
+/// before meshing, Obs A.1).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum HoleFilter {
+    /// Keep every hole.
+    #[default]
+    KeepAll,
+    /// Drop holes whose area is below this value (region units squared).
+    MinArea(f64),
+    /// Drop holes whose area is below this fraction of the outer ring's area.
+    MinAreaFraction(f64),
+}
+
+/// Options of [`simplify_region`]. `Default` is modified areas with the clean preset (ε = 1),
+/// all holes kept.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SimplifyOptions {
+    /// The method.
+    pub method: Method,
+    /// Which defaults to use when `epsilon` / `delta` are not given.
+    pub preset: Preset,
+    /// Threshold ε (overrides the preset's).
+    pub epsilon: Option<f64>,
+    /// MPP factor δ (overrides the preset's; ignored by methods without the MPP step).
+    pub delta: Option<f64>,
+    /// Hole dropping.
+    pub holes: HoleFilter,
+    /// MPP solver tuning.
+    pub mpp: MppOptions,
+}
+
+impl SimplifyOptions {
+    /// Options for `method` with the given preset and everything else default.
+    pub fn new(method: Method, preset: Preset) -> Self {
+        Self {
+            method,
+            preset,
+            ..Self::default()
+        }
+    }
+}
+
+/// Per-ring figures of a simplification.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RingReport {
+    /// Which ring of the **input** region (hole numbers are input numbers).
+    pub ring: RingId,
+    /// Vertices before.
+    pub before: usize,
+    /// Vertices after.
+    pub after: usize,
+    /// `(A_after − A_before) / A_before` of this ring's enclosed area.
+    pub relative_area_change: f64,
+    /// Hausdorff distance between the input ring and the simplified ring.
+    pub hausdorff: f64,
+}
+
+/// A hole removed by the [`HoleFilter`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DroppedHole {
+    /// Its number in the input region.
+    pub hole: usize,
+    /// Its area.
+    pub area: f64,
+    /// Its vertex count.
+    pub vertices: usize,
+}
+
+/// Everything [`simplify_region`] produces.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimplifyResult {
+    /// The simplified region (validated by [`Region::new`]).
+    pub region: Region,
+    /// The method used.
+    pub method: Method,
+    /// The preset the defaults came from (`Auto` resolved to `Clean` or `Noisy`).
+    pub preset: Preset,
+    /// The threshold ε used.
+    pub epsilon: f64,
+    /// The MPP factor δ used, if the method has an MPP step.
+    pub delta: Option<f64>,
+    /// Outer ring first, then the kept holes, in input order.
+    pub rings: Vec<RingReport>,
+    /// Holes dropped by the filter.
+    pub dropped_holes: Vec<DroppedHole>,
+    /// Total vertices of the input region.
+    pub vertices_before: usize,
+    /// Total vertices of the result.
+    pub vertices_after: usize,
+    /// Region area (outer minus holes) before.
+    pub area_before: f64,
+    /// Region area after.
+    pub area_after: f64,
+    /// `(area_after − area_before) / area_before` (includes the effect of dropped holes).
+    pub relative_area_change: f64,
+    /// Largest Hausdorff distance between a kept input ring and its simplified version.
+    pub hausdorff: f64,
+    /// Wall time of the simplification itself (hole filter, removal, MPP, final validation;
+    /// not the metrics).
+    pub elapsed: Duration,
+}
+
+fn check_param(name: &'static str, v: f64) -> Result<f64, ContourError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(ContourError::InvalidParameter {
+            name,
+            value: v,
+            reason: "must be finite and >= 0",
+        })
+    }
+}
+
+/// Simplifies every ring of `region` (outer ring and each kept hole separately, §3.3, Obs 3.3)
+/// with `opts.method`, never letting a ring self-intersect or touch another ring (see
+/// the crate documentation, *Topology safety*), and validates the result with [`Region::new`].
+pub fn simplify_region(
+    region: &Region,
+    opts: &SimplifyOptions,
+) -> Result<SimplifyResult, ContourError> {
+    let t0 = Instant::now();
+    let preset = match opts.preset {
+        Preset::Auto => {
+            if crate::noise::detect_noise_region(region).0 {
+                Preset::Noisy
+            } else {
+                Preset::Clean
+            }
+        }
+        p => p,
+    };
+    let method = opts.method;
+    let eps = check_param(
+        "epsilon",
+        opts.epsilon.unwrap_or(method.default_epsilon(preset)),
+    )?;
+    let delta = match method.default_delta(preset) {
+        Some(d) => Some(check_param("delta", opts.delta.unwrap_or(d))?),
+        None => None,
+    };
+    // hole filter
+    let outer_area = region.outer().area();
+    let min_area = match opts.holes {
+        HoleFilter::KeepAll => 0.0,
+        HoleFilter::MinArea(a) => check_param("min_hole_area", a)?,
+        HoleFilter::MinAreaFraction(f) => check_param("min_hole_area_fraction", f)? * outer_area,
+    };
+    let mut kept: Vec<usize> = Vec::new();
+    let mut dropped_holes = Vec::new();
+    for (k, h) in region.holes().iter().enumerate() {
+        if h.area() < min_area {
+            dropped_holes.push(DroppedHole {
+                hole: k,
+                area: h.area(),
+                vertices: h.len(),
+            });
+        } else {
+            kept.push(k);
+        }
+    }
+    let input: Vec<Vec<DVec2>> = std::iter::once(region.outer().points().to_vec())
+        .chain(kept.iter().map(|&k| region.holes()[k].points().to_vec()))
+        .collect();
+    let output = run_method(&input, method, eps, delta, &opts.mpp)?;
+    let mut it = output.into_iter();
+    let outer = it.next().unwrap_or_default();
+    let simplified = Region::new(outer, it.collect())?;
+    let elapsed = t0.elapsed();
+
+    let rings: Vec<RingReport> = simplified
+        .rings()
+        .zip(&input)
+        .enumerate()
+        .map(|(k, (s, orig))| {
+            let a0 = crate::signed_area_abs(orig);
+            RingReport {
+                ring: if k == 0 {
+                    RingId::Outer
+                } else {
+                    RingId::Hole(kept[k - 1])
+                },
+                before: orig.len(),
+                after: s.len(),
+                relative_area_change: (s.area() - a0) / a0,
+                hausdorff: hausdorff(orig, s.points()),
+            }
+        })
+        .collect();
+    let area_before = region.area();
+    let area_after = simplified.area();
+    Ok(SimplifyResult {
+        vertices_before: region.num_vertices(),
+        vertices_after: simplified.num_vertices(),
+        relative_area_change: (area_after - area_before) / area_before,
+        hausdorff: rings.iter().map(|r| r.hausdorff).fold(0.0, f64::max),
+        region: simplified,
+        method,
+        preset,
+        epsilon: eps,
+        delta,
+        rings,
+        dropped_holes,
+        area_before,
+        area_after,
+        elapsed,
+    })
+}
+
+/// Runs one method on a valid set of rings (outer first); returns the new rings.
+fn run_method(
+    input: &[Vec<DVec2>],
+    method: Method,
+    eps: f64,
+    delta: Option<f64>,
+    mpp: &MppOptions,
+) -> Result<Vec<Vec<DVec2>>, ContourError> {
+    let extract = |ws: &Workspace| -> Vec<Vec<DVec2>> {
+        (0..ws.num_rings()).map(|r| ws.ring_points(r)).collect()
+    };
+    let mut ws = Workspace::new(input);
+    let n_rings = input.len();
+    match method {
+        Method::Visvalingam => {
+            for (r, ring) in input.iter().enumerate() {
+                let abar = mean_triangle_area(ring);
+                sequential(&mut ws, r, triangle_area, Stop::Below(eps * abar));
+            }
+        }
+        Method::Areas => {
+            for r in 0..n_rings {
+                batch(&mut ws, r, |a, b, c, mean| {
+                    weighted_area(a, b, c) < 2.0 * eps * mean
+                });
+            }
+        }
+        Method::Radii => {
+            for r in 0..n_rings {
+                batch(&mut ws, r, |a, b, c, _| radius_ratio(a, b, c) < eps);
+            }
+        }
+        Method::ModifiedAreas | Method::ModifiedRadii => {
+            let key = if method == Method::ModifiedAreas {
+                weighted_area
+            } else {
+                modified_radius
+            };
+            for (r, ring) in input.iter().enumerate() {
+                let abar = mean_triangle_area(ring);
+                sequential(&mut ws, r, key, Stop::Below(eps * abar));
+            }
+        }
+        Method::ThreeStep => {
+            for r in 0..n_rings {
+                batch(&mut ws, r, |a, b, c, mean| {
+                    weighted_area(a, b, c) < 2.0 * 1e-4 * mean
+                });
+            }
+            let moved = mpp_step(&extract(&ws), delta.unwrap_or(0.0), mpp)?;
+            ws = Workspace::new(&moved);
+            for r in 0..n_rings {
+                batch(&mut ws, r, |a, b, c, _| radius_ratio(a, b, c) < eps);
+            }
+        }
+        Method::ModifiedThreeStep => {
+            let abar: Vec<f64> = input.iter().map(|r| mean_triangle_area(r)).collect();
+            for (r, &ab) in abar.iter().enumerate() {
+                sequential(&mut ws, r, weighted_area, Stop::Below(0.1 * ab));
+            }
+            let moved = mpp_step(&extract(&ws), delta.unwrap_or(0.0), mpp)?;
+            ws = Workspace::new(&moved);
+            for (r, &ab) in abar.iter().enumerate() {
+                sequential(&mut ws, r, weighted_area, Stop::Below(eps * ab));
+            }
+        }
+    }
+    Ok(extract(&ws))
+}
+
+/// MPP on every ring separately, then a topology repair: vertices of edges that came to
+/// intersect (or coincide) are put back at their input positions until the rings are valid
+/// again. Each round restores at least one moved vertex, and the all-restored configuration is
+/// the valid input, so this terminates with a valid region.
+fn mpp_step(
+    rings: &[Vec<DVec2>],
+    delta: f64,
+    opts: &MppOptions,
+) -> Result<Vec<Vec<DVec2>>, ContourError> {
+    // rings are independent problems: solve them in parallel
+    let mut moved = rings
+        .par_iter()
+        .map(|ring| minimum_perimeter_polygon(ring, delta, opts).map(|r| r.points))
+        .collect::<Result<Vec<_>, _>>()?;
+    loop {
+        let conflicts = conflicts(&moved);
+        if conflicts.is_empty() {
+            let mut it = moved.iter().cloned();
+            let outer = it.next().unwrap_or_default();
+            if Region::new(outer, it.collect()).is_ok() {
+                return Ok(moved);
+            }
+            return Ok(rings.to_vec());
+        }
+        let mut progress = false;
+        for (r, i) in conflicts {
+            if moved[r][i] != rings[r][i] {
+                moved[r][i] = rings[r][i];
+                progress = true;
+            }
+        }
+        if !progress {
+            return Ok(rings.to_vec());
+        }
+    }
+}
+
+/// Vertices involved in any defect of the rings: repeated consecutive points, intersecting or
+/// touching non-adjacent edges (same or different ring), folded-back adjacent edges.
+fn conflicts(rings: &[Vec<DVec2>]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    for (r, ring) in rings.iter().enumerate() {
+        let n = ring.len();
+        for i in 0..n {
+            if ring[i] == ring[(i + 1) % n] {
+                out.push((r, i));
+                out.push((r, (i + 1) % n));
+            }
+        }
+    }
+    if !out.is_empty() {
+        return out;
+    }
+    let index = SegmentIndex::new(rings.to_vec());
+    for (r, ring) in rings.iter().enumerate() {
+        let n = ring.len();
+        for e in 0..n {
+            let (a, b) = (ring[e], ring[(e + 1) % n]);
+            for o in index.intersecting(a, b) {
+                if (o.ring, o.edge) <= (r, e) {
+                    continue;
+                }
+                let hit = if o.ring == r && o.edge == (e + 1) % n {
+                    let c = ring[(e + 2) % n];
+                    orient2d(a, b, c) == 0.0 && (a - b).dot(c - b) > 0.0
+                } else if o.ring == r && e == (o.edge + 1) % n {
+                    let z = ring[(e + n - 1) % n];
+                    orient2d(z, a, b) == 0.0 && (z - a).dot(b - a) > 0.0
+                } else {
+                    true
+                };
+                if hit {
+                    let m = rings[o.ring].len();
+                    out.extend([
+                        (r, e),
+                        (r, (e + 1) % n),
+                        (o.ring, o.edge),
+                        (o.ring, (o.edge + 1) % m),
+                    ]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Symmetric Hausdorff distance between two closed polylines, measured at the vertices and
+/// edge midpoints of each against the exact segments of the other (R*-tree range queries). Exact whenever one ring's vertices are a subset of the other's and the extreme
+/// point is a vertex; otherwise a close lower bound.
+pub fn hausdorff(a: &[DVec2], b: &[DVec2]) -> f64 {
+    directed_hausdorff(a, b).max(directed_hausdorff(b, a))
+}
+
+fn directed_hausdorff(from: &[DVec2], to: &[DVec2]) -> f64 {
+    let (n, m) = (from.len(), to.len());
+    if n == 0 || m == 0 {
+        return if n == m { 0.0 } else { f64::INFINITY };
+    }
+    let seg = |k: usize| (to[k], to[(k + 1) % m]);
+    let tree = RTree::bulk_load(
+        (0..m)
+            .map(|k| {
+                let (p, q) = seg(k);
+                GeomWithData::new(Rectangle::from_corners([p.x, p.y], [q.x, q.y]), k)
+            })
+            .collect(),
+    );
+    // Exact nearest-segment distance by a range query whose radius is an upper bound: the
+    // distance to the segment that was nearest for the previous sample point (samples move
+    // along `from`, so it is usually tight).
+    let mut last = 0usize;
+    let mut worst = 0.0f64;
+    for k in 0..n {
+        let p = from[k];
+        let mid = 0.5 * (p + from[(k + 1) % n]);
+        for x in [p, mid] {
+            let (a, b) = seg(last);
+            let mut best = point_segment_distance(x, a, b);
+            if best > 0.0 {
+                let env = AABB::from_corners([x.x - best, x.y - best], [x.x + best, x.y + best]);
+                for e in tree.locate_in_envelope_intersecting(&env) {
+                    let (a, b) = seg(e.data);
+                    let d = point_segment_distance(x, a, b);
+                    if d < best {
+                        best = d;
+                        last = e.data;
+                    }
+                }
+            }
+            worst = worst.max(best);
+        }
+    }
+    worst
+}

@@ -1,0 +1,1129 @@
+//! The automatic decomposition: Algorithm 1 driving Algorithms 2–4 (seed 000 digest §3.2),
+//! with the cut score documented in the crate root, and the assembly of the final blocks.
+
+use std::f64::consts::PI;
+
+use unamalla_mesh::{DVec2, Region};
+
+use crate::concavity::{concavity, Tolerances};
+use crate::corners::{quad_fit, select_corners, triangle_rule, CornerWeights};
+use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
+use crate::error::DecomposeError;
+use crate::geom::{angle_penalty, left_angle, perimeter, project_t, ray_segment, ring_angle};
+use crate::piece::{End, Piece, Pos, Ring, Tag};
+
+/// Weights of the cut score S (see the crate documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CutWeights {
+    /// w_a: weight of the angle penalty of the four new angles at the cut ends.
+    pub angle: f64,
+    /// w_l: weight of the cut length relative to √area of the piece.
+    pub length: f64,
+    /// w_h: weight of the hole-arc balance of the second hole cut.
+    pub hole_balance: f64,
+}
+
+impl Default for CutWeights {
+    fn default() -> Self {
+        Self {
+            angle: 0.5,
+            length: 0.1,
+            hole_balance: 1.5,
+        }
+    }
+}
+
+/// Options of [`decompose`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecomposeOptions {
+    /// Concavity tolerances and the critical angle θ₋.
+    pub tolerances: Tolerances,
+    /// Pieces smaller than this fraction of the region's area are "negligible": no cut may
+    /// create one (default 2·10⁻⁴).
+    pub min_area_fraction: f64,
+    /// Stop splitting when this many blocks exist (default 400).
+    pub max_blocks: usize,
+    /// How many of the deepest reflex vertices are tried as the start p of a concavity cut
+    /// (default 10).
+    pub concave_starts: usize,
+    /// Cut score weights.
+    pub cut_weights: CutWeights,
+    /// Corner score weights.
+    pub corner_weights: CornerWeights,
+    /// Run Algorithm 4 (extract triangles around critical angles; default `true`).
+    pub critical_triangles: bool,
+    /// Run the cleanup pass that removes cuts whose two blocks form a better block together
+    /// (default `true`).
+    pub merge_blocks: bool,
+    /// Distance of the points inserted by the triangle-block rule, as a fraction of the
+    /// shorter incident edge (default 0.25).
+    pub triangle_insert_fraction: f64,
+}
+
+impl Default for DecomposeOptions {
+    fn default() -> Self {
+        Self {
+            tolerances: Tolerances::default(),
+            min_area_fraction: 2e-4,
+            max_blocks: 400,
+            concave_starts: 10,
+            cut_weights: CutWeights::default(),
+            corner_weights: CornerWeights::default(),
+            critical_triangles: true,
+            merge_blocks: true,
+            triangle_insert_fraction: 0.25,
+        }
+    }
+}
+
+/// Decomposes a region automatically into admissible blocks with four corners each
+/// (Algorithm 1 with exclusive branches: holes → Algorithm 2, not approximately convex →
+/// Algorithm 3, critical angles → Algorithm 4), then selects corners.
+pub fn decompose(
+    region: &Region,
+    opts: &DecomposeOptions,
+) -> Result<Decomposition, DecomposeError> {
+    let mut b = Builder::new(region, opts);
+    b.run_auto(0)?;
+    b.finish()
+}
+
+/// A candidate cut inside a piece.
+#[derive(Clone, Copy, Debug)]
+struct Cand {
+    e1: End,
+    e2: End,
+    pre: f64,
+}
+
+pub(crate) struct Builder<'a> {
+    pub region: &'a Region,
+    pub opts: &'a DecomposeOptions,
+    pub cuts: Vec<(DVec2, DVec2)>,
+    pub nodes: Vec<TreeNode>,
+    pub pieces: Vec<Option<Piece>>,
+    /// Cuts with an id below this were given by the user and are never merged away.
+    pub protected_cuts: usize,
+    min_area: f64,
+}
+
+impl<'a> Builder<'a> {
+    pub fn new(region: &'a Region, opts: &'a DecomposeOptions) -> Self {
+        let outer = Ring {
+            pts: region.outer().points().to_vec(),
+            tags: vec![Tag::Boundary(0); region.outer().len()],
+        };
+        let holes = region
+            .holes()
+            .iter()
+            .enumerate()
+            .map(|(k, h)| Ring {
+                pts: h.points().to_vec(),
+                tags: vec![Tag::Boundary(k + 1); h.len()],
+            })
+            .collect();
+        Self {
+            region,
+            opts,
+            cuts: Vec::new(),
+            nodes: vec![TreeNode {
+                label: String::new(),
+                parent: None,
+                children: Vec::new(),
+                step: None,
+                cuts: Vec::new(),
+                block: None,
+            }],
+            pieces: vec![Some(Piece { outer, holes })],
+            protected_cuts: 0,
+            min_area: opts.min_area_fraction * region.area(),
+        }
+    }
+
+    fn leaves(&self) -> usize {
+        self.nodes.iter().filter(|n| n.children.is_empty()).count()
+    }
+
+    /// Replaces leaf `node` by two children.
+    pub fn branch(
+        &mut self,
+        node: usize,
+        step: Step,
+        cuts: Vec<usize>,
+        a: Piece,
+        b: Piece,
+    ) -> [usize; 2] {
+        let mut ids = [0; 2];
+        for (k, p) in [a, b].into_iter().enumerate() {
+            let label = if self.nodes[node].label.is_empty() {
+                format!("{}", k + 1)
+            } else {
+                format!("{}.{}", self.nodes[node].label, k + 1)
+            };
+            self.nodes.push(TreeNode {
+                label,
+                parent: Some(node),
+                children: Vec::new(),
+                step: None,
+                cuts: Vec::new(),
+                block: None,
+            });
+            self.pieces.push(Some(p));
+            ids[k] = self.nodes.len() - 1;
+        }
+        self.nodes[node].children = ids.to_vec();
+        self.nodes[node].step = Some(step);
+        self.nodes[node].cuts = cuts;
+        self.pieces[node] = None;
+        ids
+    }
+
+    pub fn new_cut(&mut self, a: DVec2, b: DVec2) -> usize {
+        self.cuts.push((a, b));
+        self.cuts.len() - 1
+    }
+
+    /// Algorithm 1 on the subtree rooted at `root` (a leaf).
+    pub fn run_auto(&mut self, root: usize) -> Result<(), DecomposeError> {
+        let mut stack = vec![root];
+        while let Some(n) = stack.pop() {
+            let Some(piece) = self.pieces[n].clone() else {
+                continue;
+            };
+            if self.leaves() >= self.opts.max_blocks && piece.holes.is_empty() {
+                continue;
+            }
+            let tol = &self.opts.tolerances;
+            let out = if !piece.holes.is_empty() {
+                let (a, b, c1, c2) = self.remove_hole(&piece)?;
+                Some((Step::HoleRemoval, vec![c1, c2], a, b, true))
+            } else {
+                let conc = concavity(&piece.outer.pts);
+                let mut r = None;
+                if !conc.approximately_convex(tol) {
+                    r = self
+                        .concavity_cut(&piece)
+                        .map(|(a, b, c)| (Step::Concavity, vec![c], a, b, true));
+                }
+                if r.is_none() && self.opts.critical_triangles && piece.outer.len() > 3 {
+                    r = self
+                        .critical_cut(&piece)
+                        .map(|(a, b, c)| (Step::CriticalAngle, vec![c], a, b, false));
+                }
+                r
+            };
+            if let Some((step, cuts, a, b, both)) = out {
+                let ids = self.branch(n, step, cuts, a, b);
+                // DFS: child 1 first
+                stack.push(ids[1]);
+                if both {
+                    stack.push(ids[0]);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The two new angles at a cut end going towards `target`: (angle on the side of the
+    /// outgoing edge, angle on the side of the incoming edge).
+    fn end_angles(piece: &Piece, e: End, target: DVec2) -> (f64, f64) {
+        let (prev, cur, next) = piece.chain(e);
+        (left_angle(target, cur, next), left_angle(prev, cur, target))
+    }
+
+    /// Angle penalty ḡ of a candidate cut and its smallest new angle, or `None` if a new angle
+    /// is below the tier's limit: tiers 0 and 1 use θ₋ (tier 0 also requires that a reflex start
+    /// vertex is resolved: both new angles at `e1` at most 180°), tier 2 uses ½θ₋, tier 3 uses
+    /// ⅕θ₋ (relaxed passes, only tried when the stricter ones find nothing).
+    fn angle_terms(&self, piece: &Piece, e1: End, e2: End, tier: usize) -> Option<(f64, f64)> {
+        let p = piece.point(e1);
+        let q = piece.point(e2);
+        let (a, b) = Self::end_angles(piece, e1, q);
+        let (c, d) = Self::end_angles(piece, e2, p);
+        let min = a.min(b).min(c).min(d);
+        let theta = self.opts.tolerances.theta_minus;
+        let limit = match tier {
+            0 | 1 => theta,
+            2 => 0.5 * theta,
+            _ => 0.2 * theta,
+        };
+        if min < limit {
+            return None;
+        }
+        if tier == 0 && a.max(b) > PI + 1e-9 {
+            return None;
+        }
+        let pen = angle_penalty(a) + angle_penalty(b) + angle_penalty(c) + angle_penalty(d);
+        Some((pen / 4.0, min))
+    }
+
+    /// Feet of the perpendicular from `p` on the boundary-tagged edges of ring `r` of the piece
+    /// (strictly inside the edge, away from its ends), plus the ring's vertices.
+    fn targets_on_ring(
+        piece: &Piece,
+        r: usize,
+        p: DVec2,
+        skip: &dyn Fn(usize) -> bool,
+        out: &mut Vec<End>,
+    ) {
+        let ring = piece.ring(r);
+        let n = ring.len();
+        for i in 0..n {
+            if !skip(i) {
+                out.push(End {
+                    ring: r,
+                    pos: Pos::Vertex(i),
+                });
+            }
+            if skip(i) || skip((i + 1) % n) {
+                continue;
+            }
+            if let Tag::Boundary(_) = ring.tags[i] {
+                let a = ring.p(i);
+                let b = ring.next(i);
+                let t = project_t(p, a, b);
+                if t > 0.03 && t < 0.97 {
+                    out.push(End {
+                        ring: r,
+                        pos: Pos::OnEdge(i, a + t * (b - a)),
+                    });
+                }
+            }
+        }
+    }
+
+    /// Algorithm 2: removes the hole nearest to the outer ring with two cuts.
+    fn remove_hole(
+        &mut self,
+        piece: &Piece,
+    ) -> Result<(Piece, Piece, usize, usize), DecomposeError> {
+        let region_hole = |piece: &Piece, k: usize| match piece.holes[k - 1].tags[0] {
+            Tag::Boundary(r) => r.saturating_sub(1),
+            Tag::Cut(_) => 0,
+        };
+        let area_scale = piece.area().abs().sqrt();
+        for tier in [1, 2, 3] {
+            // --- first cut: shortest admissible bridges between a hole and the outer ring
+            let idx = piece.index();
+            let mut cands: Vec<Cand> = Vec::new();
+            for k in 1..=piece.holes.len() {
+                let h = piece.ring(k);
+                for j in 0..h.len() {
+                    let q = h.p(j);
+                    let mut t = Vec::new();
+                    Self::targets_on_ring(piece, 0, q, &|_| false, &mut t);
+                    for e in t {
+                        cands.push(Cand {
+                            e1: e,
+                            e2: End {
+                                ring: k,
+                                pos: Pos::Vertex(j),
+                            },
+                            pre: piece.point(e).distance(q),
+                        });
+                    }
+                }
+                for i in 0..piece.outer.len() {
+                    let p = piece.outer.p(i);
+                    let mut t = Vec::new();
+                    Self::targets_on_ring(piece, k, p, &|_| true, &mut t);
+                    // only the feet (vertices were covered above)
+                    for j in 0..h.len() {
+                        let a = h.p(j);
+                        let b = h.next(j);
+                        let tt = project_t(p, a, b);
+                        if tt > 0.03 && tt < 0.97 {
+                            t.push(End {
+                                ring: k,
+                                pos: Pos::OnEdge(j, a + tt * (b - a)),
+                            });
+                        }
+                    }
+                    for e in t {
+                        cands.push(Cand {
+                            e1: End {
+                                ring: 0,
+                                pos: Pos::Vertex(i),
+                            },
+                            e2: e,
+                            pre: p.distance(piece.point(e)),
+                        });
+                    }
+                }
+            }
+            cands.sort_by(|a, b| a.pre.total_cmp(&b.pre));
+            let mut found: Vec<(f64, Cand)> = Vec::new();
+            let mut lmin = None;
+            for c in &cands {
+                if found.len() >= 60 {
+                    break;
+                }
+                if !piece.admissible(&idx, c.e1, c.e2) {
+                    continue;
+                }
+                let Some((pen, _)) = self.angle_terms(piece, c.e1, c.e2, tier) else {
+                    continue;
+                };
+                let l = *lmin.get_or_insert(c.pre.max(1e-300));
+                let s = c.pre / l + self.opts.cut_weights.angle * pen;
+                found.push((s, *c));
+            }
+            found.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for (_, c1) in found {
+                if let Some(r) = self.second_hole_cut(piece, c1, tier, area_scale) {
+                    return Ok(r);
+                }
+            }
+        }
+        Err(DecomposeError::HoleNotRemoved {
+            hole: region_hole(piece, 1),
+        })
+    }
+
+    fn second_hole_cut(
+        &mut self,
+        piece: &Piece,
+        c1: Cand,
+        tier: usize,
+        _area_scale: f64,
+    ) -> Option<(Piece, Piece, usize, usize)> {
+        let k = c1.e2.ring;
+        let hole_per = perimeter(&piece.ring(k).pts);
+        let len1 = c1.pre;
+        let mut m = piece.clone();
+        let (i, j) = m.insert_ends(c1.e1, c1.e2);
+        let cut1_pts = (m.outer.p(i), m.ring(k).p(j));
+        let (qa, qb, pb) = m.merge(i, k, j, usize::MAX);
+        let n = m.outer.len();
+        // arc length along the hole part from qa
+        let mut arc = vec![0.0; n + 1];
+        for s in qa..qb {
+            arc[s + 1] = arc[s] + m.outer.p(s).distance(m.outer.next(s));
+        }
+        let in_outer = |s: usize| s < i || s > pb;
+        let reference = len1 + hole_per / PI;
+        let idx = m.index();
+        let mut cands: Vec<(Cand, f64)> = Vec::new();
+        for (s, &arc_s) in arc.iter().enumerate().take(qb).skip(qa + 1) {
+            let q = m.outer.p(s);
+            let f = arc_s / hole_per;
+            let bal = 4.0 * (f - 0.5) * (f - 0.5);
+            for t in 0..n {
+                if !in_outer(t) {
+                    continue;
+                }
+                let mut ends = vec![End {
+                    ring: 0,
+                    pos: Pos::Vertex(t),
+                }];
+                if in_outer((t + 1) % n) && matches!(m.outer.tags[t], Tag::Boundary(_)) {
+                    let a = m.outer.p(t);
+                    let b = m.outer.next(t);
+                    let tt = project_t(q, a, b);
+                    if tt > 0.03 && tt < 0.97 {
+                        ends.push(End {
+                            ring: 0,
+                            pos: Pos::OnEdge(t, a + tt * (b - a)),
+                        });
+                    }
+                }
+                for e in ends {
+                    let l = m.point(e).distance(q);
+                    cands.push((
+                        Cand {
+                            e1: End {
+                                ring: 0,
+                                pos: Pos::Vertex(s),
+                            },
+                            e2: e,
+                            pre: self.opts.cut_weights.hole_balance * bal + l / reference,
+                        },
+                        l,
+                    ));
+                }
+            }
+        }
+        cands.sort_by(|a, b| a.0.pre.total_cmp(&b.0.pre));
+        let mut best: Option<(f64, Piece, Piece, DVec2, DVec2)> = None;
+        let mut tested = 0;
+        for (c, _) in &cands {
+            if tested >= 40 {
+                break;
+            }
+            if !m.admissible(&idx, c.e1, c.e2) {
+                continue;
+            }
+            let Some((pen, _)) = self.angle_terms(&m, c.e1, c.e2, tier) else {
+                continue;
+            };
+            let mut m2 = m.clone();
+            let (x, y) = m2.insert_ends(c.e1, c.e2);
+            let (a, b) = m2.split(x, y, usize::MAX - 1);
+            if a.area() < self.min_area || b.area() < self.min_area {
+                continue;
+            }
+            tested += 1;
+            let s = c.pre + self.opts.cut_weights.angle * pen;
+            if best.as_ref().is_none_or(|b| s < b.0) {
+                best = Some((s, a, b, m2.outer.p(x), m2.outer.p(y)));
+            }
+        }
+        let (_, a, b, xa, xb) = best?;
+        // commit: real cut ids
+        let id1 = self.new_cut(cut1_pts.0, cut1_pts.1);
+        let id2 = self.new_cut(xa, xb);
+        let fix = |mut p: Piece| {
+            for r in std::iter::once(&mut p.outer).chain(p.holes.iter_mut()) {
+                for t in &mut r.tags {
+                    if *t == Tag::Cut(usize::MAX) {
+                        *t = Tag::Cut(id1);
+                    } else if *t == Tag::Cut(usize::MAX - 1) {
+                        *t = Tag::Cut(id2);
+                    }
+                }
+            }
+            p
+        };
+        Some((fix(a), fix(b), id1, id2))
+    }
+
+    /// Badness B(P) of a hole-free piece: its corner score F* if it is approximately convex
+    /// (it will be a block), else 1 + κ₂ + κ₃ (it will be cut again).
+    fn badness(&self, ring: &[DVec2]) -> f64 {
+        let c = concavity(ring);
+        if c.approximately_convex(&self.opts.tolerances) {
+            quad_fit(ring)
+        } else {
+            1.0 + c.kappa2 + c.kappa3
+        }
+    }
+
+    /// Algorithm 3: one concavity cut from a deep reflex vertex p to the best q.
+    fn concavity_cut(&mut self, piece: &Piece) -> Option<(Piece, Piece, usize)> {
+        let ring = &piece.outer;
+        let n = ring.len();
+        let conc = concavity(&ring.pts);
+        let area = piece.area();
+        let sq = area.sqrt();
+        let mut starts: Vec<usize> = (0..n)
+            .filter(|&i| ring_angle(&ring.pts, i) > PI && conc.point_kappa3[i] > 0.0)
+            .collect();
+        starts.sort_by(|&a, &b| {
+            conc.point_kappa3[b]
+                .total_cmp(&conc.point_kappa3[a])
+                .then(ring.p(a).x.total_cmp(&ring.p(b).x))
+                .then(ring.p(a).y.total_cmp(&ring.p(b).y))
+        });
+        starts.truncate(self.opts.concave_starts);
+        let idx = piece.index();
+        let w = self.opts.cut_weights;
+        for tier in 0..4 {
+            let mut cands: Vec<Cand> = Vec::new();
+            for &i in &starts {
+                let p = ring.p(i);
+                let e1 = End {
+                    ring: 0,
+                    pos: Pos::Vertex(i),
+                };
+                let mut t = Vec::new();
+                let near = |j: usize| j == i || j == (i + 1) % n || j == (i + n - 1) % n;
+                Self::targets_on_ring(piece, 0, p, &near, &mut t);
+                // rays: extensions of both incident edges and the bisector
+                let din = (p - ring.prev(i)).normalize_or_zero();
+                let dout = (p - ring.next(i)).normalize_or_zero();
+                let bis = (din + dout).normalize_or_zero();
+                for d in [din, dout, bis] {
+                    if d == DVec2::ZERO {
+                        continue;
+                    }
+                    if let Some(e) = Self::ray_hit(ring, i, p, d) {
+                        t.push(e);
+                    }
+                }
+                for e2 in t {
+                    let q = piece.point(e2);
+                    let Some((pen, _)) = self.angle_terms(piece, e1, e2, tier) else {
+                        continue;
+                    };
+                    cands.push(Cand {
+                        e1,
+                        e2,
+                        pre: w.angle * pen + w.length * p.distance(q) / sq,
+                    });
+                }
+            }
+            cands.sort_by(|a, b| {
+                a.pre.total_cmp(&b.pre).then_with(|| {
+                    let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
+                    pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
+                })
+            });
+            let mut best: Option<(f64, Cand)> = None;
+            let mut evaluated = 0;
+            for c in &cands {
+                if evaluated >= 60 {
+                    break;
+                }
+                if !piece.admissible(&idx, c.e1, c.e2) {
+                    continue;
+                }
+                let mut m = piece.clone();
+                let (x, y) = m.insert_ends(c.e1, c.e2);
+                let (a, b) = m.split(x, y, usize::MAX);
+                let (aa, ab) = (a.area(), b.area());
+                // the last tier also accepts pieces down to a tenth of the negligible area
+                let min_area = if tier == 3 {
+                    0.1 * self.min_area
+                } else {
+                    self.min_area
+                };
+                if aa < min_area || ab < min_area {
+                    continue;
+                }
+                evaluated += 1;
+                let ba = self.badness(&a.outer.pts);
+                let bb = self.badness(&b.outer.pts);
+                let s = 0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre;
+                if best.as_ref().is_none_or(|b| s < b.0) {
+                    best = Some((s, *c));
+                }
+            }
+            if let Some((_, c)) = best {
+                let mut m = piece.clone();
+                let (x, y) = m.insert_ends(c.e1, c.e2);
+                let id = self.new_cut(m.outer.p(x), m.outer.p(y));
+                let (a, b) = m.split(x, y, id);
+                return Some((a, b, id));
+            }
+        }
+        None
+    }
+
+    /// First boundary point hit by the ray from vertex `i` in direction `d`.
+    fn ray_hit(ring: &Ring, i: usize, p: DVec2, d: DVec2) -> Option<End> {
+        let n = ring.len();
+        let mut best: Option<(f64, usize, f64)> = None;
+        for e in 0..n {
+            if e == i || (e + 1) % n == i {
+                continue;
+            }
+            if let Some((s, t)) = ray_segment(p, d, ring.p(e), ring.next(e)) {
+                if best.is_none_or(|b| s < b.0) {
+                    best = Some((s, e, t));
+                }
+            }
+        }
+        let (_, e, t) = best?;
+        if t > 0.03 && t < 0.97 && matches!(ring.tags[e], Tag::Boundary(_)) {
+            Some(End {
+                ring: 0,
+                pos: Pos::OnEdge(e, p + d * ray_segment(p, d, ring.p(e), ring.next(e))?.0),
+            })
+        } else {
+            let v = if t < 0.5 { e } else { (e + 1) % n };
+            (v != i).then_some(End {
+                ring: 0,
+                pos: Pos::Vertex(v),
+            })
+        }
+    }
+
+    /// Algorithm 4: cut a triangle around the sharpest critical angle.
+    fn critical_cut(&mut self, piece: &Piece) -> Option<(Piece, Piece, usize)> {
+        let ring = &piece.outer;
+        let n = ring.len();
+        let theta = self.opts.tolerances.theta_minus;
+        let mut acute: Vec<(f64, usize)> = (0..n)
+            .map(|i| (ring_angle(&ring.pts, i), i))
+            .filter(|x| x.0 < theta)
+            .collect();
+        acute.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let idx = piece.index();
+        for (_, v) in acute {
+            let ep = (v + n - 1) % n;
+            if !matches!(ring.tags[ep], Tag::Boundary(_))
+                || !matches!(ring.tags[v], Tag::Boundary(_))
+            {
+                continue;
+            }
+            let pv = ring.p(v);
+            let prev = ring.prev(v);
+            let next = ring.next(v);
+            let mut d = 0.5 * pv.distance(prev).min(pv.distance(next));
+            for _ in 0..4 {
+                let p = pv + (prev - pv).normalize() * d;
+                let q = pv + (next - pv).normalize() * d;
+                let e1 = End {
+                    ring: 0,
+                    pos: Pos::OnEdge(ep, p),
+                };
+                let e2 = End {
+                    ring: 0,
+                    pos: Pos::OnEdge(v, q),
+                };
+                let tri_area = 0.5 * (pv - p).perp_dot(q - p).abs();
+                if tri_area < self.min_area {
+                    break;
+                }
+                if piece.admissible(&idx, e1, e2) {
+                    let mut m = piece.clone();
+                    let (x, y) = m.insert_ends(e1, e2);
+                    let id = self.new_cut(m.outer.p(x), m.outer.p(y));
+                    let (a, b) = m.split(x, y, id);
+                    return Some((a, b, id));
+                }
+                d *= 0.5;
+            }
+        }
+        None
+    }
+
+    /// Inserts `p` on edge `e` of block ring `bid`; if that edge is a cut, the point is also
+    /// inserted in the neighbour's ring and the cut is split in two (the second half gets a new
+    /// cut id, recorded in the tree node of the original cut).
+    fn insert_on_edge(&mut self, rings: &mut [Ring], bid: usize, e: usize, p: DVec2) {
+        let tag = rings[bid].tags[e];
+        match tag {
+            Tag::Boundary(_) => {
+                rings[bid].pts.insert(e + 1, p);
+                rings[bid].tags.insert(e + 1, tag);
+            }
+            Tag::Cut(c) => {
+                let u = rings[bid].p(e);
+                let new_id = self.cuts.len();
+                let (a, b) = self.cuts[c];
+                // cut c keeps the half at its endpoint a
+                let (half_u, half_v) = if a == u { (c, new_id) } else { (new_id, c) };
+                self.cuts[c] = (a, p);
+                self.cuts.push((p, b));
+                if let Some(node) = self.nodes.iter_mut().find(|n| n.cuts.contains(&c)) {
+                    node.cuts.push(new_id);
+                }
+                rings[bid].pts.insert(e + 1, p);
+                rings[bid].tags[e] = Tag::Cut(half_u);
+                rings[bid].tags.insert(e + 1, Tag::Cut(half_v));
+                // the neighbour: the other ring with an edge tagged c
+                for (k, r) in rings.iter_mut().enumerate() {
+                    if k == bid {
+                        continue;
+                    }
+                    if let Some(f) = r.tags.iter().position(|t| *t == Tag::Cut(c)) {
+                        // its edge runs v → u
+                        r.pts.insert(f + 1, p);
+                        r.tags[f] = Tag::Cut(half_v);
+                        r.tags.insert(f + 1, Tag::Cut(half_u));
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The cleanup pass: removes every cut whose two blocks form a better block together.
+    /// Two blocks sharing exactly one cut (and no other point) are merged when the union is
+    /// approximately convex, has no critical angle and its corner score is not worse than the
+    /// worse of the two (`F*(A ∪ B) ≤ max(F*(A), F*(B)) + 0.02`). Candidates are applied in
+    /// order of gain, each block at most once per pass, until a pass merges nothing. Removed
+    /// cuts are dropped and the remaining cuts renumbered; leaf nodes of the tree point to the
+    /// merged block.
+    fn merge_pass(&mut self, rings: Vec<Ring>) -> Vec<Ring> {
+        let tol = self.opts.tolerances;
+        let mut slot: Vec<Option<Ring>> = rings.into_iter().map(Some).collect();
+        let mut owner: Vec<usize> = (0..slot.len()).collect(); // union-find over slots
+        fn root(o: &mut [usize], x: usize) -> usize {
+            let mut r = x;
+            while o[r] != r {
+                r = o[r];
+            }
+            o[x] = r;
+            r
+        }
+        let mut fit: Vec<f64> = slot
+            .iter()
+            .map(|r| r.as_ref().map_or(0.0, |r| quad_fit(&r.pts)))
+            .collect();
+        let mut alive_cut = vec![true; self.cuts.len()];
+        loop {
+            // cut → (slot, edge) uses
+            let mut uses: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.cuts.len()];
+            for (k, r) in slot.iter().enumerate() {
+                if let Some(r) = r {
+                    for (e, t) in r.tags.iter().enumerate() {
+                        if let Tag::Cut(c) = t {
+                            uses[*c].push((k, e));
+                        }
+                    }
+                }
+            }
+            let mut cands: Vec<(f64, usize, Ring)> = Vec::new();
+            for (c, u) in uses.iter().enumerate() {
+                if c < self.protected_cuts || u.len() != 2 || u[0].0 == u[1].0 {
+                    continue;
+                }
+                let ((ka, ea), (kb, eb)) = (u[0], u[1]);
+                let (Some(a), Some(b)) = (&slot[ka], &slot[kb]) else {
+                    continue;
+                };
+                // exactly one shared cut and no other shared point
+                let shared = a.pts.iter().filter(|p| b.pts.contains(p)).count();
+                if shared != 2 {
+                    continue;
+                }
+                let na = a.len();
+                let nb = b.len();
+                // A: edge ea runs u → v; union = A from v around to u, then B after u to before v
+                let mut pts = Vec::with_capacity(na + nb - 2);
+                let mut tags = Vec::with_capacity(na + nb - 2);
+                for s in 1..=na {
+                    let k = (ea + s) % na;
+                    pts.push(a.pts[k]);
+                    tags.push(if s == na {
+                        b.tags[(eb + 1) % nb]
+                    } else {
+                        a.tags[k]
+                    });
+                }
+                for s in 2..nb {
+                    let k = (eb + s) % nb;
+                    pts.push(b.pts[k]);
+                    tags.push(b.tags[k]);
+                }
+                if pts.len() < 3 || tags.len() != pts.len() {
+                    continue;
+                }
+                let conc = concavity(&pts);
+                if !conc.approximately_convex(&tol)
+                    || !crate::concavity::critical_angles(&pts, tol.theta_minus).is_empty()
+                {
+                    continue;
+                }
+                let f = quad_fit(&pts);
+                let worst = fit[ka].max(fit[kb]);
+                // a triangle bounded by cuts only could get its fourth corner only inside a cut
+                // (a valence-3 interior node): merge it whenever the union is admissible
+                let cut_triangle =
+                    |r: &Ring| r.len() == 3 && r.tags.iter().all(|t| matches!(t, Tag::Cut(_)));
+                if f <= worst + 0.02 || cut_triangle(a) || cut_triangle(b) {
+                    cands.push((worst - f, c, Ring { pts, tags }));
+                }
+            }
+            if cands.is_empty() {
+                break;
+            }
+            cands.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+            let mut touched = vec![false; slot.len()];
+            let mut merged = false;
+            for (_, c, ring) in cands {
+                let u = &uses[c];
+                let (ka, kb) = (u[0].0, u[1].0);
+                if touched[ka] || touched[kb] {
+                    continue;
+                }
+                touched[ka] = true;
+                touched[kb] = true;
+                fit[ka] = quad_fit(&ring.pts);
+                slot[ka] = Some(ring);
+                slot[kb] = None;
+                owner[kb] = ka;
+                alive_cut[c] = false;
+                merged = true;
+            }
+            if !merged {
+                break;
+            }
+        }
+        // renumber cuts and blocks
+        let mut new_id = vec![usize::MAX; self.cuts.len()];
+        let mut cuts = Vec::new();
+        for (c, &alive) in alive_cut.iter().enumerate() {
+            if alive {
+                new_id[c] = cuts.len();
+                cuts.push(self.cuts[c]);
+            }
+        }
+        self.cuts = cuts;
+        let mut block_of_slot = vec![usize::MAX; slot.len()];
+        let mut out = Vec::new();
+        for (k, r) in slot.into_iter().enumerate() {
+            if let Some(mut r) = r {
+                for t in &mut r.tags {
+                    if let Tag::Cut(c) = t {
+                        *c = new_id[*c];
+                    }
+                }
+                block_of_slot[k] = out.len();
+                out.push(r);
+            }
+        }
+        for node in &mut self.nodes {
+            node.cuts.retain(|c| new_id[*c] != usize::MAX);
+            for c in &mut node.cuts {
+                *c = new_id[*c];
+            }
+            if let Some(b) = node.block {
+                let r = root(&mut owner, b);
+                node.block = Some(block_of_slot[r]);
+            }
+        }
+        out
+    }
+
+    /// Turns the leaves into blocks, resolves neighbours, applies the triangle rule, selects
+    /// corners and validates the result.
+    pub fn finish(mut self) -> Result<Decomposition, DecomposeError> {
+        // leaves in DFS order (child 1 before child 2)
+        let mut order = Vec::new();
+        let mut stack = vec![0usize];
+        while let Some(n) = stack.pop() {
+            if self.nodes[n].children.is_empty() {
+                order.push(n);
+            } else {
+                for &c in self.nodes[n].children.iter().rev() {
+                    stack.push(c);
+                }
+            }
+        }
+        let mut rings: Vec<Ring> = Vec::with_capacity(order.len());
+        for (bid, &n) in order.iter().enumerate() {
+            let Some(piece) = self.pieces[n].take() else {
+                continue;
+            };
+            if let Some(h) = piece.holes.first() {
+                let hole = match h.tags[0] {
+                    Tag::Boundary(r) => r.saturating_sub(1),
+                    Tag::Cut(_) => 0,
+                };
+                return Err(DecomposeError::HoleNotSeparated { hole });
+            }
+            let mut seen_cuts: Vec<usize> = piece
+                .outer
+                .tags
+                .iter()
+                .filter_map(|t| match t {
+                    Tag::Cut(c) => Some(*c),
+                    Tag::Boundary(_) => None,
+                })
+                .collect();
+            let total = seen_cuts.len();
+            seen_cuts.sort_unstable();
+            seen_cuts.dedup();
+            if seen_cuts.len() != total {
+                // a hole bridged by one cut but never separated by a second one
+                let hole = piece
+                    .outer
+                    .tags
+                    .iter()
+                    .find_map(|t| match t {
+                        Tag::Boundary(r) if *r > 0 => Some(r - 1),
+                        _ => None,
+                    })
+                    .unwrap_or(0);
+                return Err(DecomposeError::HoleNotSeparated { hole });
+            }
+            self.nodes[n].block = Some(bid);
+            rings.push(piece.outer);
+        }
+        let rings = if self.opts.merge_blocks {
+            self.merge_pass(rings)
+        } else {
+            rings
+        };
+        // cut → blocks
+        let mut sides: Vec<Vec<usize>> = vec![Vec::new(); self.cuts.len()];
+        for (bid, r) in rings.iter().enumerate() {
+            for t in &r.tags {
+                if let Tag::Cut(c) = t {
+                    sides[*c].push(bid);
+                }
+            }
+        }
+        let theta = self.opts.tolerances.theta_minus;
+        let mut rings = rings;
+        // phase A: triangle-block rule (inserting points, splitting cuts when needed)
+        let mut corner_points: Vec<Option<[DVec2; 4]>> = vec![None; rings.len()];
+        for bid in 0..rings.len() {
+            let pts = rings[bid].pts.clone();
+            if !is_triangle_like(&pts, &self.opts.corner_weights) {
+                continue;
+            }
+            // insert on original boundary only if possible: a corner inside a cut would be an
+            // interior node of valence 3 in the mesh; splitting the cut is the last resort
+            let tags = rings[bid].tags.clone();
+            let boundary_only = |e: usize| matches!(tags[e], Tag::Boundary(_));
+            let frac = self.opts.triangle_insert_fraction;
+            let non_reflex = (0..pts.len()).filter(|&i| ring_angle(&pts, i) < PI).count();
+            let Some((new_pts, origin, corners)) = triangle_rule(&pts, theta, frac, &boundary_only)
+                .or_else(|| {
+                    // with four non-reflex vertices, phase B picks corners among them instead
+                    (non_reflex < 4)
+                        .then(|| {
+                            // keep the critical vertex as a corner, fourth corner on boundary
+                            triangle_rule(&pts, 0.0, frac, &boundary_only)
+                                .or_else(|| triangle_rule(&pts, theta, frac, &|_| true))
+                        })
+                        .flatten()
+                })
+            else {
+                continue;
+            };
+            // apply insertions from the last to the first so edge indices stay valid
+            let mut ins: Vec<(usize, DVec2)> = origin
+                .iter()
+                .zip(&new_pts)
+                .filter_map(|(o, p)| o.map(|e| (e, *p)))
+                .collect();
+            ins.sort_by(|a, b| {
+                b.0.cmp(&a.0).then_with(|| {
+                    let base = pts[a.0];
+                    b.1.distance(base).total_cmp(&a.1.distance(base))
+                })
+            });
+            for (e, p) in ins {
+                self.insert_on_edge(&mut rings, bid, e, p);
+            }
+            corner_points[bid] = Some(corners.map(|k| new_pts[k]));
+        }
+        // cut → blocks
+        let mut sides: Vec<Vec<usize>> = vec![Vec::new(); self.cuts.len()];
+        for (bid, r) in rings.iter().enumerate() {
+            for t in &r.tags {
+                if let Tag::Cut(c) = t {
+                    sides[*c].push(bid);
+                }
+            }
+        }
+        let cuts: Vec<Cut> = self
+            .cuts
+            .iter()
+            .enumerate()
+            .map(|(id, &(a, b))| Cut {
+                id,
+                a,
+                b,
+                blocks: [
+                    sides[id].first().copied().unwrap_or(0),
+                    sides[id].get(1).copied().unwrap_or(0),
+                ],
+            })
+            .collect();
+        // phase B: corners
+        let mut blocks = Vec::with_capacity(rings.len());
+        for (bid, r) in rings.into_iter().enumerate() {
+            let edges: Vec<EdgeKind> = r
+                .tags
+                .iter()
+                .map(|t| match *t {
+                    Tag::Boundary(ring) => EdgeKind::Boundary { ring },
+                    Tag::Cut(c) => EdgeKind::Cut {
+                        cut: c,
+                        neighbour: cuts[c].blocks[if cuts[c].blocks[0] == bid { 1 } else { 0 }],
+                    },
+                })
+                .collect();
+            let (corners, triangle) = match corner_points[bid] {
+                Some(cp) => {
+                    let mut c: Vec<usize> = cp
+                        .iter()
+                        .filter_map(|p| r.pts.iter().position(|x| x == p))
+                        .collect();
+                    c.sort_unstable();
+                    if c.len() != 4 {
+                        return Err(DecomposeError::BadCorners {
+                            block: bid,
+                            reason: "triangle-block corners were lost".into(),
+                        });
+                    }
+                    ([c[0], c[1], c[2], c[3]], true)
+                }
+                None => match select_corners(&r.pts, &self.opts.corner_weights).or_else(|| {
+                    // fallback: any four non-reflex vertices, however straight
+                    let w = CornerWeights {
+                        max_corner_angle: PI,
+                        ..self.opts.corner_weights
+                    };
+                    select_corners(&r.pts, &w)
+                }) {
+                    Some((c, _)) => (c, false),
+                    None => {
+                        return Err(DecomposeError::BadCorners {
+                            block: bid,
+                            reason: "fewer than four non-reflex vertices".into(),
+                        })
+                    }
+                },
+            };
+            blocks.push(Block {
+                id: bid,
+                ring: r.pts,
+                corners,
+                edges,
+                triangle,
+            });
+        }
+        let d = Decomposition {
+            blocks,
+            cuts,
+            tree: self.nodes,
+        };
+        d.validate(self.region)?;
+        Ok(d)
+    }
+}
+
+/// `true` if a block gets the triangle-block rule: three vertices, or fewer than four
+/// corner-like (interior angle below θ_max) vertices.
+fn is_triangle_like(ring: &[DVec2], w: &CornerWeights) -> bool {
+    let n = ring.len();
+    n == 3
+        || (0..n)
+            .filter(|&i| ring_angle(ring, i) < w.max_corner_angle)
+            .count()
+            < 4
+}
+
+/// A block's (possibly extended) ring, its edge bookkeeping, corners and triangle flag.
+pub(crate) type CornerChoice = (Vec<DVec2>, Vec<EdgeKind>, [usize; 4], bool);
+
+/// Corner choice for one block: the quadrilateral selection, or the triangle rule when the
+/// block has fewer than four corner-like vertices or is a triangle.
+pub(crate) fn choose_corners(
+    block: usize,
+    ring: &[DVec2],
+    edges: &[EdgeKind],
+    theta_minus: f64,
+    opts: &DecomposeOptions,
+) -> Result<CornerChoice, DecomposeError> {
+    let n = ring.len();
+    let strong = (0..n)
+        .filter(|&i| ring_angle(ring, i) < opts.corner_weights.max_corner_angle)
+        .count();
+    if n == 3 || strong < 4 {
+        let can = |e: usize| matches!(edges[e], EdgeKind::Boundary { .. });
+        if let Some((pts, origin, corners)) =
+            triangle_rule(ring, theta_minus, opts.triangle_insert_fraction, &can)
+        {
+            // edge k describes pts[k] → pts[k+1]: an old vertex i starts a piece of old edge i,
+            // an inserted point on edge e continues old edge e.
+            let mut fixed = Vec::with_capacity(pts.len());
+            let mut cur = 0usize;
+            for o in &origin {
+                match o {
+                    None => {
+                        fixed.push(edges[cur]);
+                        cur += 1;
+                    }
+                    Some(e) => fixed.push(edges[*e]),
+                }
+            }
+            return Ok((pts, fixed, corners, true));
+        }
+    }
+    match select_corners(ring, &opts.corner_weights) {
+        Some((c, _)) => Ok((ring.to_vec(), edges.to_vec(), c, false)),
+        None => Err(DecomposeError::BadCorners {
+            block,
+            reason: "fewer than four non-reflex vertices and the triangle rule does not apply"
+                .into(),
+        }),
+    }
+}

@@ -1,0 +1,155 @@
+//! Small geometric helpers shared by the decomposition modules (exact predicates come from
+//! `unamalla_mesh::geometry`).
+
+use std::f64::consts::{PI, TAU};
+
+use unamalla_mesh::geometry::orient2d;
+use unamalla_mesh::DVec2;
+
+/// Counter-clockwise angle from direction `u` to direction `v`, in `(0, 2π]`.
+pub(crate) fn ccw_angle(u: DVec2, v: DVec2) -> f64 {
+    let a = u.perp_dot(v).atan2(u.dot(v));
+    if a <= 0.0 {
+        a + TAU
+    } else {
+        a
+    }
+}
+
+/// Angle at `cur` on the left of the directed chain `prev → cur → next`, in `(0, 2π]`.
+pub(crate) fn left_angle(prev: DVec2, cur: DVec2, next: DVec2) -> f64 {
+    ccw_angle(next - cur, prev - cur)
+}
+
+/// Left angle at vertex `i` of an open ring.
+pub(crate) fn ring_angle(ring: &[DVec2], i: usize) -> f64 {
+    let n = ring.len();
+    left_angle(ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n])
+}
+
+/// `true` if the point `x` lies strictly inside the open wedge on the left of the chain
+/// `prev → cur → next` (the region side at `cur`). Exact.
+pub(crate) fn in_wedge(prev: DVec2, cur: DVec2, next: DVec2, x: DVec2) -> bool {
+    let turn = orient2d(prev, cur, next);
+    let a = orient2d(cur, next, x);
+    let b = orient2d(cur, prev, x);
+    if turn > 0.0 {
+        a > 0.0 && b < 0.0
+    } else if turn < 0.0 {
+        a > 0.0 || b < 0.0
+    } else if (next - cur).dot(prev - cur) < 0.0 {
+        a > 0.0
+    } else {
+        // zero-width spike: the left side is everything but the ray itself
+        a != 0.0 || (x - cur).dot(next - cur) < 0.0
+    }
+}
+
+/// Shoelace signed area (positive for counter-clockwise rings).
+pub(crate) fn signed_area(ring: &[DVec2]) -> f64 {
+    unamalla_mesh::region::signed_area(ring)
+}
+
+/// Perimeter of an open ring.
+pub(crate) fn perimeter(ring: &[DVec2]) -> f64 {
+    let n = ring.len();
+    (0..n).map(|k| ring[k].distance(ring[(k + 1) % n])).sum()
+}
+
+/// Area centroid of a simple ring (falls back to the vertex mean for degenerate rings).
+pub(crate) fn centroid(ring: &[DVec2]) -> DVec2 {
+    let n = ring.len();
+    let mut a = 0.0;
+    let mut c = DVec2::ZERO;
+    for k in 0..n {
+        let p = ring[k];
+        let q = ring[(k + 1) % n];
+        let w = p.perp_dot(q);
+        a += w;
+        c += (p + q) * w;
+    }
+    if a.abs() < 1e-300 {
+        ring.iter().copied().sum::<DVec2>() / n.max(1) as f64
+    } else {
+        c / (3.0 * a)
+    }
+}
+
+/// Penalty of an angle `α` (radians) for a quadrilateral-like block: `((α − π/2)/(π/2))²` for
+/// `α ≤ π` (0 at 90°, 1 at 0° and 180°), `1 + (α − π)/(π/2)` for reflex angles.
+pub(crate) fn angle_penalty(alpha: f64) -> f64 {
+    if alpha <= PI {
+        let d = (alpha - PI / 2.0) / (PI / 2.0);
+        d * d
+    } else {
+        1.0 + (alpha - PI) / (PI / 2.0)
+    }
+}
+
+/// Diameter (largest vertex distance) of a point set given by indices.
+pub(crate) fn diameter(points: &[DVec2], idx: &[usize]) -> f64 {
+    let mut d2: f64 = 0.0;
+    for (k, &i) in idx.iter().enumerate() {
+        for &j in &idx[k + 1..] {
+            d2 = d2.max(points[i].distance_squared(points[j]));
+        }
+    }
+    d2.sqrt()
+}
+
+/// Parameter `t` of the orthogonal projection of `p` on the line `ab`.
+pub(crate) fn project_t(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let d = b - a;
+    let l2 = d.length_squared();
+    if l2 == 0.0 {
+        0.0
+    } else {
+        (p - a).dot(d) / l2
+    }
+}
+
+/// First intersection of the ray `o + s·d` (`s > 0`) with segment `ab`: `(s, t)`.
+pub(crate) fn ray_segment(o: DVec2, d: DVec2, a: DVec2, b: DVec2) -> Option<(f64, f64)> {
+    let e = b - a;
+    let den = d.perp_dot(e);
+    if den.abs() < 1e-300 {
+        return None;
+    }
+    let w = a - o;
+    let s = w.perp_dot(e) / den;
+    let t = w.perp_dot(d) / den;
+    if s > 0.0 && (0.0..=1.0).contains(&t) {
+        Some((s, t))
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wedge_convex_and_reflex() {
+        let o = DVec2::ZERO;
+        // chain (0,1) → o → (1,0) turns left: the region is the first quadrant (90°)
+        let prev = DVec2::new(0.0, 1.0);
+        let next = DVec2::new(1.0, 0.0);
+        assert!(in_wedge(prev, o, next, DVec2::new(1.0, 1.0)));
+        assert!(!in_wedge(prev, o, next, DVec2::new(-1.0, -1.0)));
+        assert!(!in_wedge(prev, o, next, DVec2::new(1.0, 0.0)));
+        // reversed chain: the reflex 270° side
+        assert!(!in_wedge(next, o, prev, DVec2::new(1.0, 1.0)));
+        assert!(in_wedge(next, o, prev, DVec2::new(-1.0, -1.0)));
+        assert!(in_wedge(next, o, prev, DVec2::new(-1.0, 1.0)));
+        assert!((left_angle(prev, o, next) - PI / 2.0).abs() < 1e-12);
+        assert!((left_angle(next, o, prev) - 1.5 * PI).abs() < 1e-12);
+    }
+
+    #[test]
+    fn penalty_shape() {
+        assert_eq!(angle_penalty(PI / 2.0), 0.0);
+        assert!((angle_penalty(PI) - 1.0).abs() < 1e-12);
+        assert!((angle_penalty(1.5 * PI) - 2.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,140 @@
+//! # unamalla-decompose
+//!
+//! Stage 2 and 3a of the pipeline (seed 000 digest §3 and §4.1–4.2, thesis ch. 4 and §5.1):
+//! decompose a planar region with holes into **admissible blocks** by straight **cuts**, and
+//! choose **four corners** per block, so that every block can be meshed by a structured grid
+//! and neighbouring grids match along whole cuts (no interior singularities).
+//!
+//! ```no_run
+//! # use unamalla_mesh::Region;
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let region: Region = todo!();
+//! use unamalla_decompose::{decompose, DecomposeOptions, Decomposition};
+//! let d = decompose(&region, &DecomposeOptions::default())?;
+//! let json = d.to_json();                         // save (documented in [`file`])
+//! let again = Decomposition::from_json(&json, &region)?; // load + validate
+//! let svg = d.to_svg(&region);
+//! for block in &d.blocks {
+//!     for side in block.side_curves() {           // bottom, right, top, left
+//!         for q in side { /* q.points, q.kind: Boundary { ring } | Cut { cut, neighbour } */ }
+//!     }
+//! }
+//! # Ok(()) }
+//! ```
+//!
+//! ## What a decomposition is
+//!
+//! A [`Decomposition`] has [`Block`]s and [`Cut`]s. A cut is a straight segment between two
+//! boundary points whose open interior lies in the open region (tested exactly with
+//! `orient2d`). Each block is a simple counter-clockwise ring; `edges[i]` says whether ring edge
+//! `i` is original boundary (and of which region ring) or a whole cut (which cut, which
+//! neighbour). Cut endpoints are vertices of both adjacent blocks and every cut is exactly one
+//! edge of each of its two blocks. `corners` are four ring indices in counter-clockwise order
+//! (bottom, right, top, left sides). [`Block::side_curves`] splits each side into the curves Q_j
+//! the compatibility ILP needs (seed 000 digest §4.1). The binary tree T and the adjacency
+//! graph 𝒢 (one independent cycle per hole, [`Decomposition::graph_cycles`]) are available
+//! (§3.3). [`Decomposition::validate`] proves the tiling: cuts inside and disjoint, each cut an
+//! edge of exactly two blocks in opposite directions, every boundary edge covered exactly once
+//! in its own direction, areas adding up — which together imply that the blocks cover the
+//! region without overlap (the boundary chains of the blocks add up to the region's boundary).
+//!
+//! ## The algorithm (automatic; the thesis was interactive)
+//!
+//! Algorithm 1 (§4.2.1) with **exclusive branches** (errata 12): for a piece
+//!
+//! 1. **with holes → Algorithm 2** (hole removal): the shortest admissible bridges between a
+//!    hole and the outer ring (vertex → vertex or vertex → foot of the perpendicular on an edge)
+//!    are ranked by `ℓ/ℓ_min + w_a·ḡ` and the best one that admits a second cut is taken
+//!    (this picks the hole nearest to the outer boundary and the closest point pair). The hole
+//!    is joined to the outer ring (a weakly simple ring) and a second cut from the hole to the
+//!    outer part splits the piece in two. The second cut minimises
+//!    `w_h·4(f − ½)² + ℓ/(ℓ₁ + per(H)/π) + w_a·ḡ` where `f` is the fraction of the hole's
+//!    perimeter on one side (so the hole is split in halves, the thesis's "q₂ far from q₁"),
+//!    ℓ₁ the first cut's length. Remaining holes go to the child that contains them.
+//! 2. **not approximately convex → Algorithm 3** (concavity cut): the start p is one of the
+//!    `K` (default 10) reflex vertices with the largest point concavity κ₃(p) (deepest in their
+//!    pockets); q ranges over all vertices, the feet of the perpendiculars from p on every edge,
+//!    and the first boundary hits of the rays extending p's two edges and bisecting its angle.
+//!    Each admissible candidate is scored by the expected mesh quality of the children:
+//!
+//!    ```text
+//!    S = ½·max(B₁, B₂) + ¼·(B₁ + B₂) + w_a·ḡ + w_l·ℓ/√A
+//!    B(P) = F*(P)             if P is approximately convex (it will be a block)
+//!    B(P) = 1 + κ₂(P) + κ₃(P)  otherwise (it will be cut again; worse the less convex)
+//!    ḡ = ¼ Σ g(α) over the four new angles at the cut ends
+//!    g(α) = ((α − 90°)/90°)² for α ≤ 180°,  1 + (α − 180°)/90° for reflex α
+//!    ```
+//!
+//!    with F*(P) the best corner score of the child (module [`corners`]: corner angles near 90°,
+//!    balanced opposite sides, straight sides), A the piece's area, ℓ the cut length. The
+//!    children count equally whatever their area (an area-weighted mean let long thin wedges
+//!    through as long as the big child stayed non-convex); defaults
+//!    w_a = 0.5, w_l = 0.1, w_h = 1.5. The best S wins (the thesis's "q minimising the children's
+//!    concavity", extended by the quality terms). Candidates are pre-ranked by the cheap terms
+//!    (w_a·ḡ + w_l·ℓ/√A); the first 60 admissible ones get the full score.
+//! 3. **more than three sides and a critical angle (< θ₋ = 40°) → Algorithm 4**: a triangle
+//!    p v q with p, q on the two edges at v at the same distance d = ½·min(edge lengths) (halved
+//!    up to four times until pq is a valid cut) is cut off and left as a leaf; the triangle
+//!    angles are θ and (180° − θ)/2, the remainder gets 90° + θ/2 at p and q. A triangle
+//!    smaller than the negligible area is not extracted (the critical corner stays; such blocks
+//!    are reported as not admissible by [`Decomposition::block_admissible`]).
+//!
+//! **Validity rules** (§4.2.3): cuts are disjoint (they never cross piece boundaries and end only
+//! at vertices or inside original-boundary edges, never inside another cut); no new angle at a
+//! cut end is below θ₋, and a concavity cut must resolve its reflex start vertex (both new
+//! angles there ≤ 180°, which prevents fans of cuts from one vertex). Only when no candidate
+//! passes are relaxed tiers tried: θ₋ without the resolve rule, then ½θ₋, then ⅕θ₋. No piece may
+//! be smaller than `min_area_fraction` (2·10⁻⁴) of the region's area (the last tier accepts a
+//! tenth of that, so that a non-convex piece is not left uncut for want of room). Approximate convexity is
+//! criteria 1–4 with the thesis defaults τ₁⁻ = 0.1, τ₂⁻ = 0.45, τ₃⁻ = 0.1 (τ₄⁻ unused)
+//! (module [`concavity`](mod@concavity)). All rankings are geometric; ties are broken by
+//! coordinates, so the result does not depend on where a ring's numbering starts (tested).
+//!
+//! **Cleanup (merge) pass** (beyond the thesis): greedy splitting can leave cuts that are not
+//! needed (a strip cut off a block that was already convex). Afterwards, two blocks sharing
+//! exactly one cut are merged when their union is approximately convex, has no critical angle
+//! and its corner score is no worse than the worse of the two (F*(A ∪ B) ≤ max(F*(A), F*(B)) +
+//! 0.02) — or, for a triangle bounded by cuts only, whenever the union is admissible; best gains
+//! first, repeated until nothing merges. User cuts from a file are never
+//! merged away. The tree T keeps the split history; its leaves point to the block containing
+//! them.
+//!
+//! **Triangle-block rule and split cuts.** Blocks with three vertices or fewer than four
+//! corner-like vertices get the triangle-block rule, inserting on original boundary edges only
+//! when possible; otherwise a block with four non-reflex vertices takes its corners among them
+//! (accepting a nearly straight or sharp corner), and a three-vertex block keeps its critical
+//! vertex as a corner and gets its fourth corner at the midpoint of a boundary edge. Only a
+//! three-vertex block bounded by cuts alone gets a cut split in two (both neighbours get the vertex);
+//! such a joint is the only place where a cut endpoint may lie off the region boundary, and it
+//! is an interior mesh node of valence 3 (a singularity) — it does not occur in the fixture
+//! decompositions of `docs/results-decompose.md` unless the table says so.
+//!
+//! **Corners** ([`corners`], seed 000 digest §4.2): the best 4-tuple of non-reflex,
+//! non-collinear vertices by `F = ¼Σg(θ) + w_bal·balance + w_turn·straightness`; triangles get
+//! the triangle-block rule (two points inserted near each critical vertex, on its two edges,
+//! at the same distance).
+//!
+//! ## Files and pictures
+//!
+//! The decomposition file (module [`file`](mod@file)) saves any result and overrides any part of it
+//! (cuts only, cuts + continue automatically, or complete blocks with corners); loading
+//! validates with errors naming the block, cut, ring or vertex ([`DecomposeError`]).
+//! [`Decomposition::to_svg`] draws blocks, cuts, corners and ids.
+
+#![warn(missing_docs)]
+
+mod auto;
+pub mod concavity;
+pub mod corners;
+mod decomposition;
+pub mod error;
+pub mod file;
+mod geom;
+mod piece;
+mod render;
+
+pub use auto::{decompose, CutWeights, DecomposeOptions};
+pub use concavity::{concavity, critical_angles, is_admissible, Concavity, Pocket, Tolerances};
+pub use corners::{select_corners, CornerWeights};
+pub use decomposition::{Block, Cut, Decomposition, EdgeKind, SideCurve, Step, TreeNode};
+pub use error::DecomposeError;

@@ -1,0 +1,328 @@
+//! Work pieces of the recursive decomposition: a ring (possibly weakly simple after a hole was
+//! bridged to it) with holes, every edge tagged as original boundary or as a cut; cut
+//! admissibility inside a piece (exact), and the split / merge operations.
+
+use unamalla_mesh::geometry::open_segment_hits;
+use unamalla_mesh::{DVec2, SegmentIndex};
+
+use crate::geom::in_wedge;
+
+/// What an edge of a piece is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Tag {
+    /// A piece of region ring `r` (0 = outer, k = hole k−1).
+    Boundary(usize),
+    /// Cut number `c`.
+    Cut(usize),
+}
+
+/// An open ring with a tag per edge (`tags[i]` is the edge `pts[i] → pts[i+1]`).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Ring {
+    pub pts: Vec<DVec2>,
+    pub tags: Vec<Tag>,
+}
+
+impl Ring {
+    pub fn len(&self) -> usize {
+        self.pts.len()
+    }
+    pub fn p(&self, i: usize) -> DVec2 {
+        self.pts[i % self.pts.len()]
+    }
+    pub fn prev(&self, i: usize) -> DVec2 {
+        let n = self.pts.len();
+        self.pts[(i + n - 1) % n]
+    }
+    pub fn next(&self, i: usize) -> DVec2 {
+        self.pts[(i + 1) % self.pts.len()]
+    }
+}
+
+/// A piece: outer ring (counter-clockwise, possibly weakly simple) and holes (clockwise).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Piece {
+    pub outer: Ring,
+    pub holes: Vec<Ring>,
+}
+
+/// Position of a cut endpoint on a ring.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Pos {
+    /// At vertex `i`.
+    Vertex(usize),
+    /// At point `x` strictly inside edge `i → i+1` (not yet a vertex).
+    OnEdge(usize, DVec2),
+}
+
+/// A cut endpoint: ring `ring` of the piece (0 = outer, k = hole k−1) and a position on it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct End {
+    pub ring: usize,
+    pub pos: Pos,
+}
+
+impl Piece {
+    pub fn ring(&self, k: usize) -> &Ring {
+        if k == 0 {
+            &self.outer
+        } else {
+            &self.holes[k - 1]
+        }
+    }
+    fn ring_mut(&mut self, k: usize) -> &mut Ring {
+        if k == 0 {
+            &mut self.outer
+        } else {
+            &mut self.holes[k - 1]
+        }
+    }
+    pub fn rings(&self) -> impl Iterator<Item = &Ring> {
+        std::iter::once(&self.outer).chain(self.holes.iter())
+    }
+    pub fn point(&self, e: End) -> DVec2 {
+        match e.pos {
+            Pos::Vertex(i) => self.ring(e.ring).p(i),
+            Pos::OnEdge(_, x) => x,
+        }
+    }
+    /// The chain `prev → cur → next` around an endpoint.
+    pub fn chain(&self, e: End) -> (DVec2, DVec2, DVec2) {
+        let r = self.ring(e.ring);
+        match e.pos {
+            Pos::Vertex(i) => (r.prev(i), r.p(i), r.next(i)),
+            Pos::OnEdge(i, x) => (r.p(i), x, r.next(i)),
+        }
+    }
+    pub fn index(&self) -> SegmentIndex {
+        SegmentIndex::new(self.rings().map(|r| r.pts.clone()).collect())
+    }
+    pub fn area(&self) -> f64 {
+        self.rings().map(|r| crate::geom::signed_area(&r.pts)).sum()
+    }
+
+    /// `true` if the open segment between the two endpoints lies in the open piece (exact):
+    /// the segment leaves each endpoint into the region-side wedge and its open part meets no
+    /// edge. Endpoints inside edges are checked against the two half-edges they create.
+    pub fn admissible(&self, idx: &SegmentIndex, e1: End, e2: End) -> bool {
+        let p = self.point(e1);
+        let q = self.point(e2);
+        if p == q {
+            return false;
+        }
+        let (a1, c1, b1) = self.chain(e1);
+        let (a2, c2, b2) = self.chain(e2);
+        if !in_wedge(a1, c1, b1, q) || !in_wedge(a2, c2, b2, p) {
+            return false;
+        }
+        let host = |e: End| match e.pos {
+            Pos::OnEdge(i, _) => Some((e.ring, i)),
+            Pos::Vertex(_) => None,
+        };
+        let h1 = host(e1);
+        let h2 = host(e2);
+        if h1.is_some() && h1 == h2 {
+            return false;
+        }
+        for er in idx.candidates(p, q) {
+            let key = Some((er.ring, er.edge));
+            if key == h1 || key == h2 {
+                continue;
+            }
+            let (a, b) = idx.edge(er);
+            if open_segment_hits(p, q, a, b) {
+                return false;
+            }
+        }
+        for (e, h) in [(e1, h1), (e2, h2)] {
+            if let Some((r, i)) = h {
+                let ring = self.ring(r);
+                let x = self.point(e);
+                if open_segment_hits(p, q, ring.p(i), x) || open_segment_hits(p, q, x, ring.next(i))
+                {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// Makes both endpoints vertices (inserting on-edge points), returning their vertex indices.
+    pub fn insert_ends(&mut self, e1: End, e2: End) -> (usize, usize) {
+        let i = self.insert(e1);
+        let mut e2 = e2;
+        if e1.ring == e2.ring {
+            if let Pos::OnEdge(ei, _) = e1.pos {
+                e2.pos = match e2.pos {
+                    Pos::Vertex(k) if k > ei => Pos::Vertex(k + 1),
+                    Pos::OnEdge(k, x) if k > ei => Pos::OnEdge(k + 1, x),
+                    other => other,
+                };
+            }
+        }
+        let j = self.insert(e2);
+        let i = match e2.pos {
+            Pos::OnEdge(k, _) if e1.ring == e2.ring && i > k => i + 1,
+            _ => i,
+        };
+        (i, j)
+    }
+
+    fn insert(&mut self, e: End) -> usize {
+        match e.pos {
+            Pos::Vertex(i) => i,
+            Pos::OnEdge(i, x) => {
+                let r = self.ring_mut(e.ring);
+                let t = r.tags[i];
+                r.pts.insert(i + 1, x);
+                r.tags.insert(i + 1, t);
+                i + 1
+            }
+        }
+    }
+
+    /// Splits the outer ring at vertices `i` and `j` by cut `cut`; holes go to the child that
+    /// contains them. Returns `(A, B)` with A = `i … j` + cut, B = `j … i` + cut.
+    pub fn split(&self, i: usize, j: usize, cut: usize) -> (Piece, Piece) {
+        let r = &self.outer;
+        let n = r.len();
+        let take = |from: usize, to: usize| -> Ring {
+            let mut pts = Vec::new();
+            let mut tags = Vec::new();
+            let mut k = from;
+            loop {
+                pts.push(r.pts[k]);
+                if k == to {
+                    tags.push(Tag::Cut(cut));
+                    break;
+                }
+                tags.push(r.tags[k]);
+                k = (k + 1) % n;
+            }
+            Ring { pts, tags }
+        };
+        let a = take(i, j);
+        let b = take(j, i);
+        let mut pa = Piece {
+            outer: a,
+            holes: Vec::new(),
+        };
+        let mut pb = Piece {
+            outer: b,
+            holes: Vec::new(),
+        };
+        for h in &self.holes {
+            // the hole is disjoint from the cut, so any of its vertices decides
+            let inside_a = unamalla_mesh::geometry::locate_in_ring(&pa.outer.pts, h.pts[0])
+                == unamalla_mesh::Location::Inside;
+            if inside_a {
+                pa.holes.push(h.clone());
+            } else {
+                pb.holes.push(h.clone());
+            }
+        }
+        (pa, pb)
+    }
+
+    /// Bridges hole `hole` (1-based ring number) to the outer ring by cut `cut` between outer
+    /// vertex `i` and hole vertex `k`. Returns the positions in the new outer ring of the two
+    /// copies of the hole vertex and of the outer vertex: `(q_first, q_second, p_second)`;
+    /// `p_first = i`.
+    pub fn merge(&mut self, i: usize, hole: usize, k: usize, cut: usize) -> (usize, usize, usize) {
+        let h = self.holes.remove(hole - 1);
+        let o = &self.outer;
+        let nh = h.len();
+        let mut pts = Vec::with_capacity(o.len() + nh + 2);
+        let mut tags = Vec::with_capacity(o.len() + nh + 2);
+        pts.extend_from_slice(&o.pts[..=i]);
+        tags.extend_from_slice(&o.tags[..i]);
+        tags.push(Tag::Cut(cut));
+        for s in 0..=nh {
+            pts.push(h.pts[(k + s) % nh]);
+            if s < nh {
+                tags.push(h.tags[(k + s) % nh]);
+            }
+        }
+        tags.push(Tag::Cut(cut));
+        pts.push(o.pts[i]);
+        tags.push(o.tags[i]);
+        pts.extend_from_slice(&o.pts[i + 1..]);
+        tags.extend_from_slice(&o.tags[i + 1..]);
+        self.outer = Ring { pts, tags };
+        (i + 1, i + 1 + nh, i + 2 + nh)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64) -> DVec2 {
+        DVec2::new(x, y)
+    }
+
+    fn square_with_hole() -> Piece {
+        let outer = vec![v(0., 0.), v(4., 0.), v(4., 4.), v(0., 4.)];
+        // clockwise hole
+        let hole = vec![v(1., 1.), v(1., 3.), v(3., 3.), v(3., 1.)];
+        Piece {
+            outer: Ring {
+                tags: vec![Tag::Boundary(0); 4],
+                pts: outer,
+            },
+            holes: vec![Ring {
+                tags: vec![Tag::Boundary(1); 4],
+                pts: hole,
+            }],
+        }
+    }
+
+    #[test]
+    fn merge_then_split_gives_two_simple_pieces() {
+        let mut p = square_with_hole();
+        let idx = p.index();
+        let e1 = End {
+            ring: 0,
+            pos: Pos::OnEdge(0, v(2., 0.)),
+        };
+        let e2 = End {
+            ring: 1,
+            pos: Pos::OnEdge(3, v(2., 1.)),
+        };
+        assert!(p.admissible(&idx, e1, e2));
+        // a segment through the hole is not admissible
+        let bad = End {
+            ring: 0,
+            pos: Pos::OnEdge(2, v(2., 4.)),
+        };
+        assert!(!p.admissible(&idx, e1, bad));
+        let (i, k) = p.insert_ends(e1, e2);
+        assert_eq!(p.outer.p(i), v(2., 0.));
+        assert_eq!(p.holes[0].p(k), v(2., 1.));
+        let area = p.area();
+        let (q1, q2, p2) = p.merge(i, 1, k, 0);
+        assert_eq!(p.outer.p(q1), v(2., 1.));
+        assert_eq!(p.outer.p(q2), v(2., 1.));
+        assert_eq!(p.outer.p(p2), v(2., 0.));
+        assert!((p.area() - area).abs() < 1e-12);
+        // second cut from the hole's top to the outer top
+        let idx = p.index();
+        let top_h = p.outer.pts.iter().position(|&x| x == v(1., 3.)).unwrap();
+        let e3 = End {
+            ring: 0,
+            pos: Pos::Vertex(top_h),
+        };
+        let e4 = End {
+            ring: 0,
+            pos: Pos::Vertex(p.outer.pts.iter().position(|&x| x == v(0., 4.)).unwrap()),
+        };
+        assert!(p.admissible(&idx, e3, e4));
+        let (a, b) = p.split(
+            top_h,
+            p.outer.pts.iter().position(|&x| x == v(0., 4.)).unwrap(),
+            1,
+        );
+        assert!((a.area() + b.area() - area).abs() < 1e-12);
+        assert!(a.area() > 0.0 && b.area() > 0.0);
+    }
+}

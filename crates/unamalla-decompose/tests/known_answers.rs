@@ -1,0 +1,302 @@
+//! Known-answer tests of the decomposition (the "must show" list). Expected values are
+//! derived here from the geometry, independently of the library's formulas.
+
+use unamalla_decompose::{decompose, DecomposeOptions, Decomposition, EdgeKind, Tolerances};
+use unamalla_mesh::{DVec2, Region};
+
+fn v(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}
+
+/// Independent checks of a tiling: validation, areas, cut sharing, graph cycles, and no
+/// overlap / no gap at sample points (each interior sample lies in exactly one block).
+fn check_tiling(region: &Region, d: &Decomposition) {
+    d.validate(region).expect("valid decomposition");
+    let sum: f64 = d.blocks.iter().map(|b| b.area()).sum();
+    assert!(
+        (sum - region.area()).abs() <= 1e-9 * region.area(),
+        "areas {sum} vs {}",
+        region.area()
+    );
+    for c in &d.cuts {
+        let uses: Vec<usize> = d
+            .blocks
+            .iter()
+            .filter(|b| {
+                b.edges
+                    .iter()
+                    .any(|e| matches!(e, EdgeKind::Cut { cut, .. } if *cut == c.id))
+            })
+            .map(|b| b.id)
+            .collect();
+        assert_eq!(uses.len(), 2, "cut {} used by {uses:?}", c.id);
+        // the endpoints are vertices of both blocks
+        for &b in &uses {
+            assert!(d.blocks[b].ring.contains(&c.a) && d.blocks[b].ring.contains(&c.b));
+        }
+    }
+    assert_eq!(d.graph_cycles(), region.holes().len());
+    let (lo, hi) = region.bounding_box();
+    let k = 37;
+    for i in 0..k {
+        for j in 0..k {
+            let p = lo
+                + (hi - lo) * DVec2::new((i as f64 + 0.5) / k as f64, (j as f64 + 0.5) / k as f64);
+            let inside = region.contains_point(p);
+            let count = d
+                .blocks
+                .iter()
+                .filter(|b| {
+                    unamalla_mesh::geometry::locate_in_ring(&b.ring, p)
+                        == unamalla_mesh::Location::Inside
+                })
+                .count();
+            if inside {
+                let on_edge = d.blocks.iter().any(|b| {
+                    unamalla_mesh::geometry::locate_in_ring(&b.ring, p)
+                        == unamalla_mesh::Location::OnBoundary
+                });
+                assert!(
+                    count == 1 || (on_edge && count == 0),
+                    "{p}: in {count} blocks"
+                );
+            } else {
+                assert_eq!(count, 0, "{p} outside the region but in a block");
+            }
+        }
+    }
+    // corners: four, non-reflex, in ring order
+    for b in &d.blocks {
+        for a in b.corner_angles() {
+            assert!(
+                a <= std::f64::consts::PI + 1e-6,
+                "block {} corner {a}",
+                b.id
+            );
+        }
+    }
+}
+
+#[test]
+fn convex_quadrilateral_stays_one_block() {
+    let r = Region::new(vec![v(0., 0.), v(4., 0.5), v(3.5, 3.), v(0.2, 2.5)], vec![]).unwrap();
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    assert_eq!(d.blocks.len(), 1);
+    assert!(d.cuts.is_empty());
+    let mut c = d.blocks[0].corners;
+    c.sort_unstable();
+    assert_eq!(c, [0, 1, 2, 3]);
+    assert!(!d.blocks[0].triangle);
+    check_tiling(&r, &d);
+}
+
+#[test]
+fn square_with_square_hole_gets_at_least_four_blocks() {
+    let r = Region::new(
+        vec![v(0., 0.), v(10., 0.), v(10., 10.), v(0., 10.)],
+        vec![vec![v(4., 4.), v(6., 4.), v(6., 6.), v(4., 6.)]],
+    )
+    .unwrap();
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    assert!(d.blocks.len() >= 4, "{} blocks", d.blocks.len());
+    check_tiling(&r, &d);
+    // the hole boundary is split among the blocks: every hole edge is on some block
+    let hole_edges: usize = d
+        .blocks
+        .iter()
+        .map(|b| {
+            b.edges
+                .iter()
+                .filter(|e| **e == EdgeKind::Boundary { ring: 1 })
+                .count()
+        })
+        .sum();
+    assert!(hole_edges >= 4);
+    let tol = Tolerances::default();
+    for b in &d.blocks {
+        assert!(
+            d.block_admissible(b.id, &tol),
+            "block {} not admissible",
+            b.id
+        );
+    }
+}
+
+/// A triangle with interior angles (in degrees) `a` at the origin, `b` at (1, 0).
+fn triangle(a: f64, b: f64) -> Vec<DVec2> {
+    let (ar, br) = (a.to_radians(), b.to_radians());
+    let c = std::f64::consts::PI - ar - br;
+    // law of sines: side opposite to the third vertex is 1; |P0 P2| = sin(b)/sin(c)
+    let l = br.sin() / c.sin();
+    vec![v(0., 0.), v(1., 0.), v(l * ar.cos(), l * ar.sin())]
+}
+
+/// Expected triangle-block corners: for each critical vertex the two points at distance
+/// d = 0.25 · (shorter incident edge) on its edges; the non-critical vertices if only one is
+/// critical.
+fn expected_triangle_corners(t: &[DVec2], critical: &[usize]) -> Vec<DVec2> {
+    let mut out = Vec::new();
+    for i in 0..3 {
+        let p = t[i];
+        let prev = t[(i + 2) % 3];
+        let next = t[(i + 1) % 3];
+        if critical.contains(&i) {
+            let d = 0.25 * p.distance(prev).min(p.distance(next));
+            out.push(p + (prev - p).normalize() * d);
+            out.push(p + (next - p).normalize() * d);
+        } else if critical.len() == 1 {
+            out.push(p);
+        }
+    }
+    out
+}
+
+fn assert_triangle_block(angles: (f64, f64), critical: &[usize]) {
+    let t = triangle(angles.0, angles.1);
+    let r = Region::new(t.clone(), vec![]).unwrap();
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    assert_eq!(d.blocks.len(), 1, "a triangle is a leaf");
+    let b = &d.blocks[0];
+    assert!(b.triangle);
+    assert_eq!(b.ring.len(), 3 + 2 * critical.len());
+    let got: Vec<DVec2> = b.corners.iter().map(|&k| b.ring[k]).collect();
+    for e in expected_triangle_corners(&t, critical) {
+        assert!(
+            got.iter().any(|g| g.distance(e) < 1e-12),
+            "expected corner {e} in {got:?}"
+        );
+    }
+    check_tiling(&r, &d);
+}
+
+#[test]
+fn thesis_triangle_102_50_28() {
+    // 102° at the origin, 50° at (1,0), 28° at the third vertex (index 2)
+    assert_triangle_block((102.0, 50.0), &[2]);
+}
+
+#[test]
+fn thesis_triangle_24_78_78() {
+    assert_triangle_block((24.0, 78.0), &[0]);
+}
+
+#[test]
+fn thesis_triangle_15_20_145() {
+    assert_triangle_block((15.0, 20.0), &[0, 1]);
+}
+
+fn rhombus_with_three_holes() -> Region {
+    // long diagonal 10, short 3.2: acute angles 2·atan(1.6/5) ≈ 35.5° (critical)
+    let outer = vec![v(-5., 0.), v(0., -1.6), v(5., 0.), v(0., 1.6)];
+    let sq = |cx: f64| {
+        let h = 0.25;
+        vec![v(cx - h, -h), v(cx - h, h), v(cx + h, h), v(cx + h, -h)]
+    };
+    Region::new(outer, vec![sq(-2.0), sq(0.0), sq(2.0)]).unwrap()
+}
+
+#[test]
+fn rhombus_with_three_holes_is_admissible() {
+    let r = rhombus_with_three_holes();
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    check_tiling(&r, &d);
+    let tol = Tolerances::default();
+    for b in &d.blocks {
+        assert!(
+            d.block_admissible(b.id, &tol),
+            "block {} not admissible: {:?}",
+            b.id,
+            b.ring
+        );
+    }
+    // the two sharp corners end up in triangle blocks
+    for tip in [v(-5., 0.), v(5., 0.)] {
+        let owner: Vec<_> = d.blocks.iter().filter(|b| b.ring.contains(&tip)).collect();
+        assert_eq!(owner.len(), 1);
+        assert!(owner[0].triangle, "tip {tip} is in a non-triangle block");
+    }
+    assert!(d.blocks.len() >= 3 * 4 / 2 + 2, "{} blocks", d.blocks.len());
+}
+
+#[test]
+fn result_does_not_depend_on_ring_numbering() {
+    // a U-shaped region with one hole in the base; rotate the starting vertex of each ring
+    let outer = vec![
+        v(0., 0.),
+        v(9., 0.),
+        v(9., 7.),
+        v(6., 7.),
+        v(6., 3.),
+        v(3., 3.),
+        v(3., 7.),
+        v(0., 7.),
+    ];
+    let hole = vec![v(4., 1.), v(4., 2.), v(5., 2.), v(5., 1.)];
+    let cut_set = |d: &Decomposition| {
+        let mut s: Vec<[f64; 4]> = d
+            .cuts
+            .iter()
+            .map(|c| {
+                let (a, b) = if (c.a.x, c.a.y) < (c.b.x, c.b.y) {
+                    (c.a, c.b)
+                } else {
+                    (c.b, c.a)
+                };
+                [a.x, a.y, b.x, b.y]
+            })
+            .collect();
+        s.sort_by(|x, y| x.partial_cmp(y).unwrap());
+        s
+    };
+    let base = {
+        let r = Region::new(outer.clone(), vec![hole.clone()]).unwrap();
+        let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+        check_tiling(&r, &d);
+        (d.blocks.len(), cut_set(&d))
+    };
+    for shift in 1..outer.len() {
+        let mut o = outer.clone();
+        o.rotate_left(shift);
+        let mut h = hole.clone();
+        h.rotate_left(shift % 4);
+        let r = Region::new(o, vec![h]).unwrap();
+        let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+        assert_eq!(d.blocks.len(), base.0, "shift {shift}");
+        let cs = cut_set(&d);
+        assert_eq!(cs.len(), base.1.len());
+        for (x, y) in cs.iter().zip(&base.1) {
+            for k in 0..4 {
+                assert!(
+                    (x[k] - y[k]).abs() < 1e-9,
+                    "shift {shift}: {cs:?} vs {:?}",
+                    base.1
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn side_curves_cover_the_ring_and_separate_cuts() {
+    let r = rhombus_with_three_holes();
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    for b in &d.blocks {
+        let sides = b.side_curves();
+        let edges: usize = sides.iter().flatten().map(|q| q.points.len() - 1).sum();
+        assert_eq!(edges, b.ring.len());
+        for (s, side) in sides.iter().enumerate() {
+            assert_eq!(side[0].points[0], b.ring[b.corners[s]]);
+            assert_eq!(
+                side.last().unwrap().points.last().copied(),
+                Some(b.ring[b.corners[(s + 1) % 4]])
+            );
+            for q in side {
+                if let EdgeKind::Cut { cut, neighbour } = q.kind {
+                    assert_eq!(q.points.len(), 2, "a cut is one edge");
+                    let c = d.cuts[cut];
+                    assert!(c.blocks.contains(&neighbour) && c.blocks.contains(&b.id));
+                }
+            }
+        }
+    }
+}
