@@ -3,12 +3,20 @@
 //! Subcommands:
 //! * `unamalla tfi <region> --size MxN [--corners a,b,c,d | --auto-corners] -o out.vtk`
 //! * `unamalla quality <mesh.vtk> [--json]`
+//! * `unamalla mesh <region> [--decomposition file.json] [--cells N | --density d | --cell-size h]
+//!   [--boundary-density w] [--min-hole-area A] -o <outdir> [--json] [--quiet]`
+//! * `unamalla eval <mesh> --functional NAME [--omega w] [--k k] [--raw] [--json]`
+//! * `unamalla smooth <mesh> [--functional NAME] [--solver tn-tr|tn-ls|lbfgs|pointwise] -o out`
+//! * `unamalla simplify <region> --method NAME [--epsilon e] [--delta d] -o out.geojson [--svg f]`
+//! * `unamalla decompose <region> [--from file.json] -o decomposition.json [--svg out.svg]`
 //!
 //! Errors are reported as one line on stderr with a non-zero exit code; output files are
 //! written atomically, so a failed run never leaves a partial file.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+mod commands;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
@@ -52,6 +60,114 @@ enum Command {
         /// Print the quality report as JSON instead of a table.
         #[arg(long)]
         json: bool,
+    },
+    /// The main job: a block-structured, singularity-free, all-convex quad mesh of a region.
+    Mesh {
+        /// Region file (GeoJSON).
+        region: PathBuf,
+        /// Use this decomposition file (made for the simplified region, or for the raw region
+        /// together with --no-simplify) instead of the automatic one.
+        #[arg(long)]
+        decomposition: Option<PathBuf>,
+        /// About this many cells (default 20000).
+        #[arg(long, conflicts_with_all = ["density", "cell_size"])]
+        cells: Option<usize>,
+        /// The thesis's density factor d.
+        #[arg(long, conflicts_with = "cell_size")]
+        density: Option<usize>,
+        /// Target cell size in region units.
+        #[arg(long)]
+        cell_size: Option<f64>,
+        /// Boundary density w of (6.9) (1 = plain (6.8)).
+        #[arg(long, default_value_t = 1.0)]
+        boundary_density: f64,
+        /// Drop holes smaller than this area (region units squared); by default every hole is kept.
+        #[arg(long)]
+        min_hole_area: Option<f64>,
+        /// Mesh the region as given, without contour simplification.
+        #[arg(long)]
+        no_simplify: bool,
+        /// Output directory.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Print report.json on stdout.
+        #[arg(long)]
+        json: bool,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Value and gradient norm of a functional on a mesh (VTK legacy file).
+    Eval {
+        /// Mesh file.
+        mesh: PathBuf,
+        /// Functional name (length, area, orthogonality, area-orthogonality, smoothness,
+        /// k-smoothness, k-area, h-omega, ...).
+        #[arg(long)]
+        functional: String,
+        /// ω of h-omega.
+        #[arg(long)]
+        omega: Option<f64>,
+        /// k of the k-functionals.
+        #[arg(long)]
+        k: Option<f64>,
+        /// Plain sum over all corner triangles, no normalization.
+        #[arg(long)]
+        raw: bool,
+        /// Print JSON (the default output is JSON too; this flag is accepted for symmetry).
+        #[arg(long)]
+        json: bool,
+    },
+    /// Untangle and smooth a quad mesh (VTK legacy file) keeping every cell convex.
+    Smooth {
+        /// Mesh file.
+        mesh: PathBuf,
+        /// Functional / driver: ao-homega (default), homega, karea-length, ksmooth-area, karea, ksmooth.
+        #[arg(long, default_value = "ao-homega")]
+        functional: String,
+        /// Solver: tn-tr, tn-ls, lbfgs, pointwise.
+        #[arg(long, default_value = "tn-tr")]
+        solver: String,
+        /// Output VTK legacy file.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// No progress line.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Simplify a region's contour.
+    Simplify {
+        /// Region file (GeoJSON).
+        region: PathBuf,
+        /// visvalingam, areas, radii, modified-areas (default), modified-radii, three-step, modified-three-step.
+        #[arg(long, default_value = "modified-areas")]
+        method: String,
+        /// Threshold ε.
+        #[arg(long)]
+        epsilon: Option<f64>,
+        /// MPP factor δ.
+        #[arg(long)]
+        delta: Option<f64>,
+        /// Output GeoJSON.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Overlay picture (original and simplified rings).
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
+    /// Decompose a region into admissible four-sided blocks.
+    Decompose {
+        /// Region file (GeoJSON).
+        region: PathBuf,
+        /// Start from (or validate) this decomposition file.
+        #[arg(long)]
+        from: Option<PathBuf>,
+        /// Output decomposition JSON.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Picture of the decomposition.
+        #[arg(long)]
+        svg: Option<PathBuf>,
     },
     /// Quality report of a mesh file (VTK legacy: structured grid or quad/hex unstructured grid).
     Quality {
@@ -125,6 +241,60 @@ fn run(cli: Cli) -> Result<()> {
                 eprintln!("wrote {} ({}x{} nodes)", output.display(), m, n);
             }
         }
+        Command::Mesh {
+            region,
+            decomposition,
+            cells,
+            density,
+            cell_size,
+            boundary_density,
+            min_hole_area,
+            no_simplify,
+            output,
+            json,
+            quiet,
+        } => commands::mesh(commands::MeshArgs {
+            region,
+            decomposition,
+            cells,
+            density,
+            cell_size,
+            boundary_density,
+            min_hole_area,
+            no_simplify,
+            output,
+            json,
+            quiet,
+        })?,
+        Command::Eval {
+            mesh,
+            functional,
+            omega,
+            k,
+            raw,
+            json: _,
+        } => commands::eval(&mesh, &functional, omega, k, raw)?,
+        Command::Smooth {
+            mesh,
+            functional,
+            solver,
+            output,
+            quiet,
+        } => commands::smooth(&mesh, &functional, &solver, &output, quiet)?,
+        Command::Simplify {
+            region,
+            method,
+            epsilon,
+            delta,
+            output,
+            svg,
+        } => commands::simplify(&region, &method, epsilon, delta, &output, svg.as_deref())?,
+        Command::Decompose {
+            region,
+            from,
+            output,
+            svg,
+        } => commands::decompose(&region, from.as_deref(), &output, svg.as_deref())?,
         Command::Quality { mesh, json } => {
             let file = io::read_vtk(&mesh)?;
             let report = match &file.mesh {

@@ -170,3 +170,102 @@ fn bad_regions_fail_cleanly_without_output() {
     );
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn mesh_writes_every_output_and_report_fields() {
+    let dir = tmpdir("mesh");
+    let out = dir.join("kiwi");
+    let st = bin()
+        .arg("mesh")
+        .arg(fixture("kiwi-bird.geojson"))
+        .args(["--cells", "2000", "--quiet", "--json", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    for key in [
+        "region",
+        "cells",
+        "nodes",
+        "blocks",
+        "non_convex_cells",
+        "interior_singularities",
+        "mu_ge_0_8_percent",
+        "mu_bands",
+        "min_scaled_jacobian",
+        "p5_scaled_jacobian",
+        "min_alpha_over_mean",
+        "area_change_percent",
+        "hausdorff",
+        "holes_dropped",
+        "seconds",
+        "stage_seconds",
+    ] {
+        assert!(v.get(key).is_some(), "report.json lacks {key}");
+    }
+    assert_eq!(v["region"], "kiwi-bird");
+    assert_eq!(v["non_convex_cells"], 0);
+    assert_eq!(v["interior_singularities"], 0);
+    let blocks = v["blocks"].as_u64().unwrap() as usize;
+    let mut files = vec![
+        "mesh.vtu".to_string(),
+        "mesh.msh".into(),
+        "blocks.vtm".into(),
+        "decomposition.json".into(),
+        "decomposition.svg".into(),
+        "report.json".into(),
+        "mesh.svg".into(),
+        "mesh.png".into(),
+    ];
+    files.extend((0..blocks).map(|k| format!("block-{k}.vts")));
+    for f in files {
+        assert!(out.join(&f).is_file(), "missing {f}");
+    }
+    // report.json on disk is what --json printed
+    let disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(disk, v);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn mesh_of_a_bad_region_writes_nothing() {
+    let dir = tmpdir("meshbad");
+    let out = dir.join("out");
+    let region = dir.join("hole-outside.geojson");
+    std::fs::write(
+        &region,
+        r#"{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,1],[0,0]],[[5,5],[6,5],[6,6],[5,5]]]}"#,
+    )
+    .unwrap();
+    assert_clean_failure(
+        &[
+            "mesh",
+            region.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+    );
+    let bowtie = dir.join("bowtie.geojson");
+    std::fs::write(
+        &bowtie,
+        r#"{"type":"Polygon","coordinates":[[[0,0],[2,2],[2,0],[0,2],[0,0]]]}"#,
+    )
+    .unwrap();
+    assert_clean_failure(
+        &[
+            "mesh",
+            bowtie.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

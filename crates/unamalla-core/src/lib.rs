@@ -26,10 +26,16 @@
 #![warn(missing_docs)]
 
 pub mod corners;
+pub mod pipeline;
 pub mod render;
 pub mod single_block;
 
+pub use unamalla_compat_ilp as compat_ilp;
+pub use unamalla_contour as contour;
+pub use unamalla_decompose as decompose;
+pub use unamalla_functionals as functionals;
 pub use unamalla_io as io;
+pub use unamalla_optim as optim;
 
 /// The README's examples, compiled and run by `cargo test --doc`.
 #[doc = include_str!("../../../README.md")]
@@ -52,6 +58,18 @@ pub enum CoreError {
     /// Corners could not be chosen or the given ones are invalid.
     #[error("corners: {0}")]
     Corners(String),
+    /// Contour simplification failed.
+    #[error(transparent)]
+    Contour(#[from] unamalla_contour::ContourError),
+    /// Decomposition failed or a decomposition file is invalid.
+    #[error(transparent)]
+    Decompose(#[from] unamalla_decompose::DecomposeError),
+    /// The compatible point counts could not be found.
+    #[error(transparent)]
+    Counts(#[from] unamalla_compat_ilp::CompatError),
+    /// Smoothing failed.
+    #[error(transparent)]
+    Optim(#[from] unamalla_optim::OptimError),
     /// The operation does not apply to this region.
     #[error("{0}")]
     Unsupported(String),

@@ -426,3 +426,55 @@ fn kind_of(v: &Value) -> &'static str {
         Value::Object(_) => "an object",
     }
 }
+
+/// The GeoJSON text of a region: one `Feature` with a `Polygon` geometry, ring 0 the exterior
+/// (counter-clockwise), then the holes (clockwise), every ring closed (RFC 7946). Coordinates are
+/// written with the shortest representation that reads back to the same `f64`.
+pub fn region_to_geojson(region: &Region) -> String {
+    let ring = |pts: &[DVec2]| -> String {
+        let mut s = String::from("[");
+        for p in pts.iter().chain(pts.first()) {
+            if s.len() > 1 {
+                s.push(',');
+            }
+            s.push_str(&format!("[{:?},{:?}]", p.x, p.y));
+        }
+        s.push(']');
+        s
+    };
+    let rings: Vec<String> = region.rings().map(|r| ring(r.points())).collect();
+    format!(
+        "{{\"type\":\"Feature\",\"properties\":{{}},\"geometry\":{{\"type\":\"Polygon\",\"coordinates\":[{}]}}}}\n",
+        rings.join(",")
+    )
+}
+
+/// Writes [`region_to_geojson`] atomically.
+pub fn write_region_geojson(path: impl AsRef<Path>, region: &Region) -> Result<(), IoError> {
+    let text = region_to_geojson(region);
+    crate::atomic::atomic_write(path.as_ref(), |w| w.write_all(text.as_bytes()))
+}
+
+#[cfg(test)]
+mod write_tests {
+    use super::*;
+
+    #[test]
+    fn written_region_reads_back_identically() {
+        let outer = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(3.0, 0.1),
+            DVec2::new(2.9, 2.0),
+            DVec2::new(0.1, 1.0 / 3.0 + 1.0),
+        ];
+        let hole = vec![
+            DVec2::new(1.0, 0.5),
+            DVec2::new(1.5, 1.0),
+            DVec2::new(2.0, 0.5),
+        ];
+        let r = Region::new(outer, vec![hole]).unwrap();
+        let text = region_to_geojson(&r);
+        let back = parse_region_geojson(&text, PartSelector::Largest).unwrap();
+        assert_eq!(back, r);
+    }
+}

@@ -103,8 +103,8 @@ pub use atomic::atomic_write;
 pub use error::IoError;
 pub use geojson::{
     parse_polygon_parts, parse_region_geojson, parse_region_geojson_cleaned, parse_region_rings,
-    read_region_geojson, read_region_geojson_cleaned, read_region_rings, PartSelector,
-    PolygonRings,
+    read_region_geojson, read_region_geojson_cleaned, read_region_rings, region_to_geojson,
+    write_region_geojson, PartSelector, PolygonRings,
 };
 pub use legacy::{
     parse_con, parse_geomview_mesh, parse_red, parse_xy, read_con, read_geomview_mesh, read_red,

@@ -1,0 +1,259 @@
+//! The subcommands built on the stage crates (`mesh`, `eval`, `smooth`, `simplify`,
+//! `decompose`). Every output file is written atomically, and nothing is written before the
+//! whole computation has succeeded.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+use unamalla_core::contour::{self, HoleFilter, SimplifyOptions};
+use unamalla_core::decompose::{self as dec, Decomposition};
+use unamalla_core::io::{self, PartSelector, VtkMesh};
+use unamalla_core::mesh::quality::quad_cell_metrics;
+use unamalla_core::mesh::{QuadMesh, Region};
+use unamalla_core::optim::{self, NullObserver, Observer, ProgressObserver, SmoothOptions};
+use unamalla_core::pipeline::Mesher;
+use unamalla_core::render;
+
+fn read_region(path: &Path) -> Result<Region> {
+    let (r, removed) = io::read_region_geojson_cleaned(path, PartSelector::Largest)?;
+    if removed > 0 {
+        eprintln!("note: removed {removed} repeated point(s) from the region");
+    }
+    Ok(r)
+}
+
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    io::atomic_write(path, |w| w.write_all(text.as_bytes()))
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    io::atomic_write(path, |w| w.write_all(bytes))
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Arguments of `unamalla mesh`.
+pub struct MeshArgs {
+    pub region: PathBuf,
+    pub decomposition: Option<PathBuf>,
+    pub cells: Option<usize>,
+    pub density: Option<usize>,
+    pub cell_size: Option<f64>,
+    pub boundary_density: f64,
+    pub min_hole_area: Option<f64>,
+    pub no_simplify: bool,
+    pub output: PathBuf,
+    pub json: bool,
+    pub quiet: bool,
+}
+
+/// `unamalla mesh`.
+pub fn mesh(a: MeshArgs) -> Result<()> {
+    let region = read_region(&a.region)?;
+    let mut mesher = Mesher::new();
+    mesher = match (a.cells, a.density, a.cell_size) {
+        (_, _, Some(h)) if !(h.is_finite() && h > 0.0) => {
+            bail!("--cell-size must be a positive number")
+        }
+        (_, _, Some(h)) => mesher.cell_size(h),
+        (_, Some(d), _) => mesher.density(d),
+        (Some(n), _, _) => mesher.cells(n),
+        _ => mesher,
+    };
+    if !(a.boundary_density.is_finite() && a.boundary_density >= 1.0) {
+        bail!("--boundary-density must be a number ≥ 1");
+    }
+    mesher = mesher.boundary_density(a.boundary_density);
+    let mut sopts = SimplifyOptions::default();
+    if let Some(area) = a.min_hole_area {
+        sopts.holes = HoleFilter::MinArea(area);
+    }
+    let simplified_for_file;
+    if a.no_simplify {
+        mesher = mesher.simplify(None);
+        simplified_for_file = region.clone();
+    } else {
+        simplified_for_file = contour::simplify_region(&region, &sopts)?.region;
+        mesher = mesher.simplify(Some(sopts));
+    }
+    if let Some(f) = &a.decomposition {
+        let text =
+            std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
+        let d = Decomposition::from_json(&text, &simplified_for_file)?;
+        mesher = mesher.decomposition(d);
+    }
+    if !a.quiet {
+        mesher = mesher.on_progress(|_, msg| eprintln!("· {msg}"));
+    }
+    let mut progress = ProgressObserver::new(Duration::from_millis(200));
+    let mut null = NullObserver;
+    let observer: &mut dyn Observer = if a.quiet { &mut null } else { &mut progress };
+    let result = mesher.mesh_observed(&region, observer);
+    if !a.quiet {
+        progress.finish();
+    }
+    let result = result?;
+    let mut report = result.report;
+    report.region = a
+        .region
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+
+    // everything computed: now write
+    std::fs::create_dir_all(&a.output)
+        .with_context(|| format!("creating {}", a.output.display()))?;
+    let mesh = &result.mesh;
+    let arrays = quad_cell_metrics(mesh.global());
+    let global: Vec<(&str, &[f64])> = arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
+    let block_arrays: Vec<Vec<(&'static str, Vec<f64>)>> =
+        mesh.blocks().iter().map(quad_cell_metrics).collect();
+    let block_refs: Vec<Vec<(&str, &[f64])>> = block_arrays
+        .iter()
+        .map(|b| b.iter().map(|(k, v)| (*k, v.as_slice())).collect())
+        .collect();
+    let block_slices: Vec<&[(&str, &[f64])]> = block_refs.iter().map(|v| v.as_slice()).collect();
+    io::write_block_mesh(&a.output, mesh, &block_slices, &global)?;
+    let groups = io::msh::boundary_edge_groups(mesh.global());
+    io::write_msh_quads(a.output.join("mesh.msh"), mesh.global(), "domain", &groups)?;
+    write_text(
+        &a.output.join("decomposition.json"),
+        &result.decomposition.to_json(),
+    )?;
+    write_text(
+        &a.output.join("decomposition.svg"),
+        &result.decomposition.to_svg(&result.simplified),
+    )?;
+    write_text(
+        &a.output.join("mesh.svg"),
+        &render::quality_svg(mesh.global(), Some(&result.simplified), 1200.0),
+    )?;
+    write_bytes(
+        &a.output.join("mesh.png"),
+        &render::quality_png(mesh.global(), Some(&result.simplified), 1600)?,
+    )?;
+    let json = serde_json::to_string_pretty(&report)?;
+    write_text(&a.output.join("report.json"), &json)?;
+    if a.json {
+        println!("{json}");
+    } else if !a.quiet {
+        println!(
+            "{}: {} cells, {} blocks, non-convex {}, interior singularities {}, mu>=0.8 {:.1} %, min scaled Jacobian {:.3}, area change {:.3} %, {:.2} s -> {}",
+            report.region,
+            report.cells,
+            report.blocks,
+            report.non_convex_cells,
+            report.interior_singularities,
+            report.mu_ge_0_8_percent,
+            report.min_scaled_jacobian,
+            report.area_change_percent,
+            report.seconds,
+            a.output.display()
+        );
+    }
+    Ok(())
+}
+
+fn read_quad_mesh(path: &Path) -> Result<QuadMesh> {
+    let file = io::read_vtk(path)?;
+    Ok(match file.mesh {
+        VtkMesh::Structured2(g) => QuadMesh::from_grid(&g),
+        VtkMesh::Quads(q) => q,
+        VtkMesh::Structured3(_) | VtkMesh::Hexes(_) => {
+            bail!(
+                "{}: a hexahedral mesh; this command takes a quad mesh",
+                path.display()
+            )
+        }
+    })
+}
+
+/// `unamalla eval`.
+pub fn eval(path: &Path, name: &str, omega: Option<f64>, k: Option<f64>, raw: bool) -> Result<()> {
+    let mesh = read_quad_mesh(path)?;
+    let spec = unamalla_core::functionals::FunctionalSpec::from_name(name, omega, k)?;
+    let r = unamalla_core::functionals::evaluate(&mesh, &spec, raw)?;
+    println!(
+        "{}",
+        serde_json::json!({ "value": r.value, "gradient_norm": r.gradient_norm })
+    );
+    Ok(())
+}
+
+/// `unamalla smooth`.
+pub fn smooth(path: &Path, functional: &str, solver: &str, out: &Path, quiet: bool) -> Result<()> {
+    let mut mesh = read_quad_mesh(path)?;
+    let mut opts = SmoothOptions {
+        functional: functional.parse()?,
+        ..SmoothOptions::default()
+    };
+    opts.solver.solver = solver.parse::<optim::solver::Solver>()?;
+    let mut progress = ProgressObserver::new(Duration::from_millis(200));
+    let mut null = NullObserver;
+    let observer: &mut dyn Observer = if quiet { &mut null } else { &mut progress };
+    let report = optim::smooth(&mut mesh, &opts, observer)?;
+    let arrays = quad_cell_metrics(&mesh);
+    let data: Vec<(&str, &[f64])> = arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
+    io::write_vtk_quads(out, &mesh, &data)?;
+    eprintln!(
+        "{}: Alfamin/mean {:.4}, Inocon {} (was {}), F {:.6e}",
+        report.status,
+        report.alfamin / report.alpha_bar,
+        report.inocon,
+        report.initial_inocon,
+        report.f
+    );
+    Ok(())
+}
+
+/// `unamalla simplify`.
+pub fn simplify(
+    path: &Path,
+    method: &str,
+    epsilon: Option<f64>,
+    delta: Option<f64>,
+    out: &Path,
+    svg: Option<&Path>,
+) -> Result<()> {
+    let region = read_region(path)?;
+    let opts = SimplifyOptions {
+        method: method.parse()?,
+        epsilon,
+        delta,
+        ..SimplifyOptions::default()
+    };
+    let r = contour::simplify_region(&region, &opts)?;
+    let overlay = svg.map(|_| contour::overlay_svg(&region, &r.region));
+    io::write_region_geojson(out, &r.region)?;
+    if let (Some(p), Some(text)) = (svg, overlay) {
+        write_text(p, &text)?;
+    }
+    eprintln!(
+        "{} -> {} vertices, area change {:.4} %, Hausdorff {:.4}",
+        r.vertices_before,
+        r.vertices_after,
+        100.0 * r.relative_area_change,
+        r.hausdorff
+    );
+    Ok(())
+}
+
+/// `unamalla decompose`.
+pub fn decompose(path: &Path, from: Option<&Path>, out: &Path, svg: Option<&Path>) -> Result<()> {
+    let region = read_region(path)?;
+    let d = match from {
+        Some(f) => {
+            let text =
+                std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
+            Decomposition::from_json(&text, &region)?
+        }
+        None => dec::decompose(&region, &dec::DecomposeOptions::default())?,
+    };
+    write_text(out, &d.to_json())?;
+    if let Some(p) = svg {
+        write_text(p, &d.to_svg(&region))?;
+    }
+    eprintln!("{} blocks, {} cuts", d.blocks.len(), d.cuts.len());
+    Ok(())
+}

@@ -1,0 +1,100 @@
+//! End-to-end properties of the mesher on real regions (small meshes so the suite stays fast;
+//! the full-size runs are in `docs/results.md`).
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use unamalla_core::io::{self, PartSelector};
+use unamalla_core::mesh::geometry::point_segment_distance;
+use unamalla_core::mesh::{HasNodes, HasQuadCells, Region};
+use unamalla_core::pipeline::{MeshResult, Mesher};
+
+fn load(name: &str) -> Region {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/regions")
+        .join(name);
+    io::read_region_geojson(p, PartSelector::Largest).unwrap()
+}
+
+fn distance_to_rings(r: &Region, p: unamalla_core::mesh::DVec2) -> f64 {
+    let mut d = f64::INFINITY;
+    for ring in r.rings() {
+        let pts = ring.points();
+        for k in 0..pts.len() {
+            d = d.min(point_segment_distance(p, pts[k], pts[(k + 1) % pts.len()]));
+        }
+    }
+    d
+}
+
+fn check(result: &MeshResult, holes: usize) {
+    let rep = &result.report;
+    let mesh = result.mesh.global();
+    assert_eq!(rep.non_convex_cells, 0, "non-convex cells");
+    assert_eq!(rep.interior_singularities, 0, "interior singularities");
+    assert!(rep.holes_dropped.is_empty());
+    // no duplicate nodes
+    let mut seen = HashSet::new();
+    for p in mesh.nodes() {
+        assert!(
+            seen.insert((p.x.to_bits(), p.y.to_bits())),
+            "duplicate node {p}"
+        );
+    }
+    // conformity: the only boundary loops are the region's rings (a non-conformal cut would
+    // leave its edges unmatched and add boundary edges inside the region)
+    let loops = io::msh::boundary_loops(mesh);
+    assert_eq!(loops.len(), 1 + holes, "boundary loops");
+    // every boundary node lies on the simplified boundary
+    let (lo, hi) = result.simplified.bounding_box();
+    let tol = 1e-9 * (hi - lo).length();
+    for l in &loops {
+        for e in &l.edges {
+            let p = mesh.nodes()[e[0]];
+            assert!(
+                distance_to_rings(&result.simplified, p) <= tol,
+                "boundary node {p} off the boundary"
+            );
+        }
+    }
+    // cut nodes are shared: block boundary nodes that are not on the region boundary map to
+    // global nodes used by cells of at least two blocks
+    assert_eq!(rep.cells, mesh.num_quads());
+    assert_eq!(rep.blocks, result.decomposition.blocks.len());
+}
+
+#[test]
+fn colorado_is_one_high_quality_block() {
+    let r = Mesher::new()
+        .cells(2_000)
+        .mesh(&load("colorado.geojson"))
+        .unwrap();
+    check(&r, 0);
+    assert_eq!(r.report.blocks, 1);
+    assert!(r.report.mu_ge_0_8_percent >= 85.0);
+    assert!(r.report.area_change_percent <= 2.0);
+}
+
+#[test]
+fn kiwi_silhouette_with_a_hole() {
+    let r = Mesher::new()
+        .cells(3_000)
+        .mesh(&load("kiwi-bird.geojson"))
+        .unwrap();
+    check(&r, 1);
+    assert!(r.report.blocks > 1);
+}
+
+#[test]
+fn horse_silhouette_with_a_hole() {
+    let r = Mesher::new()
+        .cells(3_000)
+        .mesh(&load("horse.geojson"))
+        .unwrap();
+    check(&r, 1);
+    assert!(
+        r.report.mu_ge_0_8_percent >= 85.0,
+        "{}",
+        r.report.mu_ge_0_8_percent
+    );
+}

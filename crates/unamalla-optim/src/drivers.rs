@@ -1,0 +1,1024 @@
+//! Continuation drivers and the high-level `smooth` entry points.
+//!
+//! * [`adaptive_k`]: seed 001 Algorithms 4.1/4.2 with the practical update of §4.6.1
+//!   (`k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01`, a few iterations per `k`), the C²
+//!   continuation below `α̂ = −k + 0.015(α₋ + k)` (erratum 6), the double homotopy
+//!   `σ̂(k) = (1−σ)(k₀ − k)/(k₀ − k*ᾱ)` (5.20), optional Length pre-smoothing, then the classic
+//!   phase on `σ·f₁(k*) + (1−σ)·f₂`.
+//! * [`omega_continuation`] / [`omega_continuation_hex`]: seed 004 §3.4 Algorithm A — minimize
+//!   `H_ω`, halve `ω` until the mesh is ε-convex (floor `10⁻⁸`, relative to the mean measure),
+//!   then one refinement run.
+//! * [`coplanarity_continuation`]: seed 004 §4.2 Algorithm B — `H_ω + C·Σk²`, `C = 1/(2μ)`,
+//!   `μ₀ = 0.1`, `μ ← 0.1μ` while `μ > 10⁻¹²`.
+//! * [`block_smoothing`]: seed 000 (6.8)/(6.9) `F = (1−σ)·w·F_AO + σ·H_ω` (each normalized to
+//!   1 on the ideal grid) from an ε-convex start, with the safeguard at `ε·ᾱ`, so the result is
+//!   ε-convex; a non-ε-convex start is first untangled by [`adaptive_k`].
+//!
+//! Contract: every driver keeps a convex start convex (the [`Session`] safeguard), and reports
+//! in [`SmoothReport::convex`] / [`SmoothReport::eps_convex`] whether a folded start became
+//! convex.
+
+use std::str::FromStr;
+use std::sync::Arc;
+use std::time::Duration;
+
+use unamalla_functionals::{
+    recommended_alpha_hat, HOmega, HexFunctional, HexTopology, KArea, KSmoothness, Kernel2,
+    Problem, QuadFunctional, QuadTopology, Scaling3,
+};
+use unamalla_mesh::{FreeNodes, HasHexCells, HasQuadCells};
+
+use crate::error::OptimError;
+use crate::monitor::{Observer, Phase, Session};
+use crate::solver::{minimize_with, QuadLocalGuard, SolveResult, Solver, SolverOptions};
+use crate::status::{Status, StopReason};
+
+/// The adaptive functional `f₁` and its partner `f₂` (seed 001 Tables 5.1/5.2, §7.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum KFunctional {
+    /// `kSmooth-Area`: k-Smoothness with Area.
+    KSmoothArea,
+    /// `kArea-Lenght`: k-Area with Length (UNAMALLA's default).
+    #[default]
+    KAreaLength,
+    /// k-Smoothness alone.
+    KSmoothness,
+    /// k-Area alone.
+    KArea,
+}
+
+/// Options of [`adaptive_k`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AdaptiveKOptions {
+    /// The functional pair.
+    pub functional: KFunctional,
+    /// Weight σ of the adaptive functional in the final combination (UNAMALLA: 0.5; ignored
+    /// for the single functionals).
+    pub sigma: f64,
+    /// The floor `k*` in units of `ᾱ` (UNAMALLA: −0.01, i.e. target `α₋ > 0.01ᾱ`).
+    pub k_star: f64,
+    /// Solver iterations per `k` update.
+    pub iters_per_k: usize,
+    /// Maximum number of `k` updates.
+    pub max_updates: usize,
+    /// Length pre-smoothing iterations (0 = "Previous Smoothness: No").
+    pub presmooth: usize,
+    /// Run the classic phase after the homotopy.
+    pub classic: bool,
+    /// Solver options (the classic phase runs with these; the homotopy with
+    /// `max_iter = iters_per_k`).
+    pub solver: SolverOptions,
+}
+
+impl Default for AdaptiveKOptions {
+    fn default() -> Self {
+        Self {
+            functional: KFunctional::KAreaLength,
+            sigma: 0.5,
+            k_star: -0.01,
+            iters_per_k: 5,
+            max_updates: 2000,
+            presmooth: 0,
+            classic: true,
+            solver: SolverOptions::default(),
+        }
+    }
+}
+
+/// Options of Algorithm A ([`omega_continuation`], [`omega_continuation_hex`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OmegaOptions {
+    /// `ω₀` in units of the mean measure (`ᾱ` or the mean tetrahedron Jacobian).
+    pub omega0_rel: f64,
+    /// Floor of `ω`, relative (seed 004: `ω* = 10⁻⁸`).
+    pub omega_floor_rel: f64,
+    /// ε of ε-convexity (`α₋ > ε·ᾱ`).
+    pub eps: f64,
+    /// Run the refinement step after ε-convexity is reached.
+    pub refinement: bool,
+    /// Solver options of each minimization (seed 004: tolerances 10⁻⁴).
+    pub solver: SolverOptions,
+}
+
+impl Default for OmegaOptions {
+    fn default() -> Self {
+        Self {
+            omega0_rel: 1.0,
+            omega_floor_rel: 1e-8,
+            eps: 0.01,
+            refinement: true,
+            solver: SolverOptions {
+                max_iter: 100,
+                ftol: 1e-8,
+                gtol: 1e-4,
+                ..SolverOptions::default()
+            },
+        }
+    }
+}
+
+/// Options of Algorithm B ([`coplanarity_continuation`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CoplanarityOptions {
+    /// Fixed `ω` relative to the mean Jacobian (seed 004: `10⁻⁸`).
+    pub omega_rel: f64,
+    /// `μ₀` (0.1).
+    pub mu0: f64,
+    /// Stop when `μ ≤ mu_min` (10⁻¹²).
+    pub mu_min: f64,
+    /// Tolerance on `|cos|` for counting non-planar cells (criterion 2, `ε_n = 10⁻²`).
+    pub planarity_tol: f64,
+    /// Solver options of each minimization.
+    pub solver: SolverOptions,
+}
+
+impl Default for CoplanarityOptions {
+    fn default() -> Self {
+        Self {
+            omega_rel: 1e-8,
+            mu0: 0.1,
+            mu_min: 1e-12,
+            planarity_tol: 1e-2,
+            solver: SolverOptions {
+                max_iter: 50,
+                ftol: 1e-8,
+                gtol: 1e-4,
+                ..SolverOptions::default()
+            },
+        }
+    }
+}
+
+/// The report of a driver or of [`smooth`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SmoothReport {
+    /// Final status (Table A.2 message through `Display`).
+    pub status: Status,
+    /// All status messages of the run, in order.
+    pub messages: Vec<Status>,
+    /// Every element with a free vertex has a positive measure.
+    pub convex: bool,
+    /// `α₋ > ε·ᾱ` for the driver's ε.
+    pub eps_convex: bool,
+    /// The ε used for `eps_convex`.
+    pub eps: f64,
+    /// Final `α₋` over elements with a free vertex.
+    pub alfamin: f64,
+    /// `ᾱ` (mean measure).
+    pub alpha_bar: f64,
+    /// Initial `α₋`.
+    pub initial_alfamin: f64,
+    /// Initial non-convex cells.
+    pub initial_inocon: usize,
+    /// Final non-convex cells.
+    pub inocon: usize,
+    /// Elements with all vertices fixed and measure `≤ 0` (boundary data).
+    pub fixed_nonpositive: usize,
+    /// Final functional value (of the last functional minimized).
+    pub f: f64,
+    /// Final gradient norm.
+    pub gnorm: f64,
+    /// Pre-smoothing iterations.
+    pub iter_smooth: usize,
+    /// Homotopy / continuation iterations.
+    pub iter_homotopic: usize,
+    /// Classic / refinement iterations.
+    pub iter_classic: usize,
+    /// Continuation steps (`k` updates, `ω` values, `μ` values).
+    pub continuation_steps: usize,
+    /// Final `k/ᾱ` (adaptive driver).
+    pub k: Option<f64>,
+    /// Final `ω` (absolute).
+    pub omega: Option<f64>,
+    /// Final `μ` (Algorithm B).
+    pub mu: Option<f64>,
+    /// Algorithm B: max `|cos|` over interior-cell faces and the number of non-planar
+    /// interior cells.
+    pub planarity: Option<(f64, usize)>,
+    /// Wall time.
+    pub elapsed: Duration,
+}
+
+impl SmoothReport {
+    /// Total iterations over the phases.
+    pub fn iterations(&self) -> usize {
+        self.iter_smooth + self.iter_homotopic + self.iter_classic
+    }
+    /// `α₋/ᾱ`.
+    pub fn alfamin_rel(&self) -> f64 {
+        self.alfamin / self.alpha_bar
+    }
+}
+
+struct Init {
+    min: f64,
+    inocon: usize,
+}
+
+fn report(
+    session: &mut Session<'_>,
+    problem: &dyn Problem,
+    x: &[f64],
+    init: &Init,
+    messages: Vec<Status>,
+    last: Option<SolveResult>,
+    eps: f64,
+) -> SmoothReport {
+    let c = session.convexity(problem, x);
+    let status = match (last, messages.last()) {
+        (Some(r), _) => Status::Stopped {
+            reason: r.reason,
+            convex: c.convex(),
+        },
+        (None, Some(s)) => *s,
+        (None, None) => Status::InitialConvex,
+    };
+    let mut messages = messages;
+    if last.is_some() {
+        messages.push(status);
+    }
+    let m = &session.monitor;
+    SmoothReport {
+        status,
+        messages,
+        convex: c.convex(),
+        eps_convex: c.eps_convex(eps),
+        eps,
+        alfamin: c.min,
+        alpha_bar: c.mean,
+        initial_alfamin: init.min,
+        initial_inocon: init.inocon,
+        inocon: c.nonconvex_cells,
+        fixed_nonpositive: c.fixed_nonpositive,
+        f: last.map_or(m.f, |r| r.f),
+        gnorm: last.map_or(m.gnorm, |r| r.gnorm),
+        iter_smooth: m.iter_smooth,
+        iter_homotopic: m.iter_homotopic,
+        iter_classic: m.iter_classic,
+        continuation_steps: 0,
+        k: m.k_current,
+        omega: m.omega,
+        mu: m.mu,
+        planarity: None,
+        elapsed: session.elapsed(),
+    }
+}
+
+fn kernels(
+    kf: KFunctional,
+    k: f64,
+    alpha_hat: Option<f64>,
+    n: usize,
+    ab: f64,
+) -> Result<(Kernel2, Option<Kernel2>), OptimError> {
+    let f1 = match kf {
+        KFunctional::KSmoothArea | KFunctional::KSmoothness => {
+            Kernel2::KSmoothness(KSmoothness::new(k, alpha_hat)?)
+        }
+        KFunctional::KAreaLength | KFunctional::KArea => Kernel2::KArea(KArea::new(k, alpha_hat)?),
+    }
+    .normalized(n, ab)?;
+    let f2 = match kf {
+        KFunctional::KSmoothArea => Some(Kernel2::Area.normalized(n, ab)?),
+        KFunctional::KAreaLength => Some(Kernel2::Length.normalized(n, ab)?),
+        _ => None,
+    };
+    Ok((f1, f2))
+}
+
+fn combine(f1: Kernel2, f2: Option<Kernel2>, w2: f64) -> Kernel2 {
+    match f2 {
+        Some(f2) if w2 > 0.0 => Kernel2::Combination(vec![(1.0 - w2, f1), (w2, f2)]),
+        _ => f1,
+    }
+}
+
+fn check_sigma(name: &'static str, s: f64) -> Result<(), OptimError> {
+    if (0.0..=1.0).contains(&s) {
+        Ok(())
+    } else {
+        Err(OptimError::InvalidOption {
+            name,
+            value: s,
+            reason: "must lie in [0, 1]",
+        })
+    }
+}
+
+/// Seed 001 Algorithms 4.1/4.2 as implemented in UNAMALLA 2.0 (§4.6.1, §5.4): adaptive `k`
+/// with the double homotopy, then the classic phase. `x` (free-node coordinates of `topo`) is
+/// overwritten with the result.
+pub fn adaptive_k(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    opts: &AdaptiveKOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    check_sigma("sigma", opts.sigma)?;
+    if !(opts.k_star.is_finite() && opts.k_star < 1.0) {
+        return Err(OptimError::InvalidOption {
+            name: "k_star",
+            value: opts.k_star,
+            reason: "the floor k* must be finite (and below 1)",
+        });
+    }
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    let n = topo.num_triangles();
+    let guard = QuadLocalGuard::new(topo.clone());
+    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let c0 = session.convexity(&probe, x);
+    let ab = c0.mean;
+    if !(ab > 0.0 && ab.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "mean alpha",
+            value: ab,
+            reason: "the boundary must enclose a positive area (counter-clockwise)",
+        });
+    }
+    let init = Init {
+        min: c0.min,
+        inocon: c0.nonconvex_cells,
+    };
+    let mut messages = vec![if c0.convex() {
+        Status::InitialConvex
+    } else {
+        Status::InitialNonConvex
+    }];
+    let w_final = match opts.functional {
+        KFunctional::KSmoothArea | KFunctional::KAreaLength => 1.0 - opts.sigma,
+        _ => 0.0,
+    };
+    let mut last = None;
+    session.guard_threshold = 0.0;
+    // 0. pre-smoothing with Length (truncated Newton + line search)
+    if opts.presmooth > 0 {
+        session.set_phase(Phase::Smooth);
+        let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
+        let so = SolverOptions {
+            solver: Solver::TnLs,
+            max_iter: opts.presmooth,
+            ..opts.solver.clone()
+        };
+        let r = minimize_with(&p, x, &so, session, Some(&guard))?;
+        if r.reason == StopReason::User {
+            return Ok(report(
+                session,
+                &p,
+                x,
+                &init,
+                messages,
+                Some(r),
+                -opts.k_star,
+            ));
+        }
+    }
+    // 1. homotopy in k
+    session.set_phase(Phase::Homotopic);
+    let kstar = opts.k_star * ab;
+    let mut k0: Option<f64> = None;
+    let mut steps = 0;
+    let mut reached = false;
+    let hom_opts = SolverOptions {
+        max_iter: opts.iters_per_k.max(1),
+        ftol: 0.0,
+        ..opts.solver.clone()
+    };
+    for upd in 0..opts.max_updates {
+        let c = session.convexity(&probe, x);
+        let am = c.min;
+        let k = kstar.max(-1.0015 * am + 0.01 * ab);
+        let k0v = *k0.get_or_insert(k);
+        session.monitor.k_old = session.monitor.k_current;
+        session.monitor.k_current = Some(k / ab);
+        if k <= kstar && c.convex() {
+            messages.push(if upd == 0 {
+                Status::InitialGood
+            } else {
+                Status::HomotopicOk
+            });
+            reached = true;
+            break;
+        }
+        steps += 1;
+        let ah = recommended_alpha_hat(k, am);
+        let (f1, f2) = kernels(opts.functional, k, Some(ah), n, ab)?;
+        let w2 = if k0v > kstar {
+            (w_final * (k0v - k) / (k0v - kstar)).clamp(0.0, w_final)
+        } else {
+            w_final
+        };
+        let p = QuadFunctional::new(topo.clone(), combine(f1, f2, w2));
+        let r = minimize_with(&p, x, &hom_opts, session, Some(&guard))?;
+        last = Some(r);
+        if r.reason == StopReason::User {
+            let mut rep = report(session, &p, x, &init, messages, last, -opts.k_star);
+            rep.continuation_steps = steps;
+            return Ok(rep);
+        }
+    }
+    // 2. classic phase at k*
+    if opts.classic {
+        session.set_phase(Phase::Classic);
+        let c = session.convexity(&probe, x);
+        let k = if reached {
+            kstar
+        } else {
+            kstar.max(-1.0015 * c.min + 0.01 * ab)
+        };
+        let ah = recommended_alpha_hat(k, c.min);
+        let (f1, f2) = kernels(opts.functional, k, Some(ah), n, ab)?;
+        let p = QuadFunctional::new(topo.clone(), combine(f1, f2, w_final));
+        // keep α > −k once there
+        session.guard_threshold = if c.min > -k { (-k).max(0.0) } else { 0.0 };
+        let r = minimize_with(&p, x, &opts.solver, session, Some(&guard))?;
+        session.guard_threshold = 0.0;
+        last = Some(r);
+        let mut rep = report(session, &p, x, &init, messages, last, -opts.k_star);
+        rep.continuation_steps = steps;
+        return Ok(rep);
+    }
+    let mut rep = report(session, &probe, x, &init, messages, last, -opts.k_star);
+    rep.continuation_steps = steps;
+    if !reached {
+        rep.status = Status::Stopped {
+            reason: StopReason::MaxIter,
+            convex: rep.convex,
+        };
+        rep.messages.push(rep.status);
+    }
+    Ok(rep)
+}
+
+/// Seed 004 §3.4 Algorithm A on a quad mesh: minimize `H_ω` (normalized), halve `ω` until
+/// `α₋ > ε·ᾱ` or `ω` reaches the floor, then one refinement run (safeguarded at `ε·ᾱ`).
+pub fn omega_continuation(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    opts: &OmegaOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    let n = topo.num_triangles();
+    let guard = QuadLocalGuard::new(topo.clone());
+    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let c0 = session.convexity(&probe, x);
+    let ab = c0.mean;
+    if !(ab > 0.0 && ab.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "mean alpha",
+            value: ab,
+            reason: "the boundary must enclose a positive area (counter-clockwise)",
+        });
+    }
+    let make = |w: f64| -> Result<QuadFunctional<Kernel2>, OptimError> {
+        Ok(QuadFunctional::new(
+            topo.clone(),
+            Kernel2::HOmega(HOmega::new(w)?).normalized(n, ab)?,
+        ))
+    };
+    let mut omega = opts.omega0_rel * ab;
+    let floor = opts.omega_floor_rel * ab;
+    omega_loop(
+        session,
+        &probe,
+        x,
+        opts.eps,
+        ab,
+        c0,
+        &mut omega,
+        floor,
+        opts,
+        &make,
+        Some(&guard),
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn omega_loop<P: Problem>(
+    session: &mut Session<'_>,
+    probe: &dyn Problem,
+    x: &mut [f64],
+    eps: f64,
+    mean: f64,
+    c0: crate::monitor::Convexity,
+    omega: &mut f64,
+    floor: f64,
+    opts: &OmegaOptions,
+    make: &dyn Fn(f64) -> Result<P, OptimError>,
+    guard: Option<&QuadLocalGuard>,
+) -> Result<SmoothReport, OptimError> {
+    if !(*omega > 0.0 && omega.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "omega0_rel",
+            value: opts.omega0_rel,
+            reason: "ω₀ must be > 0",
+        });
+    }
+    let init = Init {
+        min: c0.min,
+        inocon: c0.nonconvex_cells,
+    };
+    let mut messages = vec![if c0.convex() {
+        Status::InitialConvex
+    } else {
+        Status::InitialNonConvex
+    }];
+    session.set_phase(Phase::Homotopic);
+    session.guard_threshold = 0.0;
+    let mut last;
+    let mut steps = 0;
+    let mut ok = false;
+    loop {
+        session.monitor.omega = Some(*omega);
+        let p = make(*omega)?;
+        let r = minimize_with(&p, x, &opts.solver, session, guard)?;
+        steps += 1;
+        last = Some(r);
+        if r.reason == StopReason::User {
+            let mut rep = report(session, &p, x, &init, messages, last, eps);
+            rep.continuation_steps = steps;
+            return Ok(rep);
+        }
+        let c = session.convexity(probe, x);
+        if c.eps_convex(eps) {
+            ok = true;
+            break;
+        }
+        if *omega * 0.5 < floor {
+            break;
+        }
+        *omega *= 0.5;
+    }
+    if ok {
+        messages.push(Status::HomotopicOk);
+        if opts.refinement {
+            session.set_phase(Phase::Classic);
+            session.guard_threshold = eps * mean;
+            let p = make(*omega)?;
+            let r = minimize_with(&p, x, &opts.solver, session, guard)?;
+            session.guard_threshold = 0.0;
+            last = Some(r);
+        }
+    }
+    let mut rep = report(session, probe, x, &init, messages, last, eps);
+    rep.continuation_steps = steps;
+    rep.omega = Some(*omega);
+    Ok(rep)
+}
+
+/// Seed 004 §3.4 Algorithm A on a hexahedral mesh (`H_ω` over the 10 tetrahedra of each
+/// hexahedron, ε-convexity `V > ε·v̄`).
+pub fn omega_continuation_hex(
+    topo: &Arc<HexTopology>,
+    scaling: Scaling3,
+    x: &mut [f64],
+    opts: &OmegaOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    let probe = HexFunctional::h_omega(topo.clone(), 1.0, scaling)?;
+    let c0 = session.convexity(&probe, x);
+    let vbar = c0.mean;
+    if !(vbar > 0.0 && vbar.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "mean volume",
+            value: vbar,
+            reason: "the mesh must have a positive mean tetrahedron volume",
+        });
+    }
+    let make = |w: f64| -> Result<HexFunctional, OptimError> {
+        Ok(HexFunctional::h_omega(topo.clone(), w, scaling)?)
+    };
+    let mut omega = opts.omega0_rel * vbar;
+    let floor = opts.omega_floor_rel * vbar;
+    omega_loop(
+        session, &probe, x, opts.eps, vbar, c0, &mut omega, floor, opts, &make, None,
+    )
+}
+
+/// Seed 004 §4.2 Algorithm B: from a convex (Algorithm A) mesh, minimize `H_ω + C·Σk²` with
+/// `C = 1/(2μ)` for `μ = μ₀, 0.1μ₀, …` while `μ > μ_min`; the safeguard keeps the mesh convex.
+pub fn coplanarity_continuation(
+    topo: &Arc<HexTopology>,
+    scaling: Scaling3,
+    x: &mut [f64],
+    opts: &CoplanarityOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    if !(opts.mu0 > 0.0 && opts.mu_min >= 0.0 && opts.mu0.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "mu0",
+            value: opts.mu0,
+            reason: "μ₀ must be > 0 and μ_min ≥ 0",
+        });
+    }
+    let probe = HexFunctional::h_omega(topo.clone(), 1.0, scaling)?;
+    let c0 = session.convexity(&probe, x);
+    let init = Init {
+        min: c0.min,
+        inocon: c0.nonconvex_cells,
+    };
+    let omega = (opts.omega_rel * c0.mean).max(f64::MIN_POSITIVE);
+    let mut messages = vec![if c0.convex() {
+        Status::InitialConvex
+    } else {
+        Status::InitialNonConvex
+    }];
+    session.set_phase(Phase::Homotopic);
+    session.guard_threshold = 0.0;
+    session.monitor.omega = Some(omega);
+    let mut mu = opts.mu0;
+    let mut last = None;
+    let mut steps = 0;
+    let mut p = HexFunctional::h_omega(topo.clone(), omega, scaling)?;
+    while mu > opts.mu_min {
+        session.monitor.mu = Some(mu);
+        p.set_coplanarity(Some(1.0 / (2.0 * mu)))?;
+        let r = minimize_with(&p, x, &opts.solver, session, None)?;
+        steps += 1;
+        last = Some(r);
+        if r.reason == StopReason::User {
+            break;
+        }
+        mu *= 0.1;
+    }
+    if last.is_none() {
+        messages.push(Status::InitialGood);
+    }
+    let mut rep = report(session, &p, x, &init, messages, last, 0.0);
+    rep.continuation_steps = steps;
+    rep.omega = Some(omega);
+    rep.mu = session.monitor.mu;
+    rep.planarity = Some(topo.planarity_report(x, opts.planarity_tol));
+    Ok(rep)
+}
+
+/// Options of [`block_smoothing`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BlockSmoothingOptions {
+    /// σ of (6.8): weight of `H_ω` (Laguna Honda example: 0.1).
+    pub sigma: f64,
+    /// Boundary density `w` of (6.9) (1 = the unweighted (6.8)).
+    pub density: f64,
+    /// Width of the boundary band of (6.9) in cell layers.
+    pub layers: usize,
+    /// ε of the guarantee: the result has `α₋ > ε·ᾱ` (and `ω = ε·ᾱ`, so `H_ω` is Winslow's
+    /// `l/α` on the whole admissible set).
+    pub eps: f64,
+    /// Untangling options for a start that is not ε-convex (its `k_star` is set to `−ε`).
+    pub untangle: AdaptiveKOptions,
+    /// Solver options of the (6.8) minimization.
+    pub solver: SolverOptions,
+}
+
+impl Default for BlockSmoothingOptions {
+    fn default() -> Self {
+        Self {
+            sigma: 0.1,
+            density: 1.0,
+            layers: 2,
+            eps: 0.01,
+            untangle: AdaptiveKOptions {
+                classic: false,
+                ..AdaptiveKOptions::default()
+            },
+            solver: SolverOptions::default(),
+        }
+    }
+}
+
+/// Seed 000 (6.8)/(6.9): `F = (1−σ)·w·F_AO + σ·H_ω` with the ε-convexity guarantee (see the
+/// module docs). `x` is overwritten.
+pub fn block_smoothing(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    opts: &BlockSmoothingOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    check_sigma("sigma", opts.sigma)?;
+    if !(opts.eps > 0.0 && opts.eps < 1.0) {
+        return Err(OptimError::InvalidOption {
+            name: "eps",
+            value: opts.eps,
+            reason: "ε must lie in (0, 1)",
+        });
+    }
+    if !(opts.density.is_finite() && opts.density > 0.0) {
+        return Err(OptimError::InvalidOption {
+            name: "density",
+            value: opts.density,
+            reason: "the boundary density must be finite and > 0",
+        });
+    }
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    let n = topo.num_triangles();
+    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let c0 = session.convexity(&probe, x);
+    let ab = c0.mean;
+    if !(ab > 0.0 && ab.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "mean alpha",
+            value: ab,
+            reason: "the boundary must enclose a positive area (counter-clockwise)",
+        });
+    }
+    let init = Init {
+        min: c0.min,
+        inocon: c0.nonconvex_cells,
+    };
+    let mut messages = vec![if c0.convex() {
+        Status::InitialConvex
+    } else {
+        Status::InitialNonConvex
+    }];
+    if !c0.eps_convex(opts.eps) {
+        let uo = AdaptiveKOptions {
+            k_star: -opts.eps,
+            classic: false,
+            ..opts.untangle.clone()
+        };
+        let r = adaptive_k(topo, x, &uo, session)?;
+        messages.extend(r.messages.iter().skip(1).copied());
+        if r.status
+            == (Status::Stopped {
+                reason: StopReason::User,
+                convex: r.convex,
+            })
+        {
+            let mut rep = report(session, &probe, x, &init, messages, None, opts.eps);
+            rep.status = r.status;
+            return Ok(rep);
+        }
+    }
+    let c = session.convexity(&probe, x);
+    let ao = Kernel2::AreaOrthogonality.normalized(n, ab)?;
+    let ao = if opts.density != 1.0 {
+        ao.cell_weighted(topo.boundary_density(opts.density, opts.layers))?
+    } else {
+        ao
+    };
+    let omega = opts.eps * ab;
+    let h = Kernel2::HOmega(HOmega::new(omega)?).normalized(n, ab)?;
+    let p = QuadFunctional::new(
+        topo.clone(),
+        Kernel2::Combination(vec![(1.0 - opts.sigma, ao), (opts.sigma, h)]),
+    );
+    session.set_phase(Phase::Classic);
+    session.monitor.k_current = None;
+    session.monitor.k_old = None;
+    session.monitor.omega = Some(omega);
+    session.guard_threshold = if c.eps_convex(opts.eps) {
+        opts.eps * ab
+    } else {
+        0.0
+    };
+    let guard = QuadLocalGuard::new(topo.clone());
+    let r = minimize_with(&p, x, &opts.solver, session, Some(&guard))?;
+    session.guard_threshold = 0.0;
+    let mut rep = report(session, &p, x, &init, messages, Some(r), opts.eps);
+    rep.omega = Some(omega);
+    Ok(rep)
+}
+
+/// The functional (and driver) of [`smooth`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum SmoothFunctional {
+    /// `ao-homega`: seed 000 (6.8)/(6.9) with the ε-convexity guarantee ([`block_smoothing`]).
+    BlockSmoothing {
+        /// σ (weight of `H_ω`).
+        sigma: f64,
+        /// Boundary density `w` (1 = plain (6.8)).
+        density: f64,
+        /// Band width in cell layers.
+        layers: usize,
+    },
+    /// `karea-length`, `ksmooth-area`, `karea`, `ksmooth`: the adaptive driver
+    /// ([`adaptive_k`]) with weight σ of the adaptive functional.
+    AdaptiveK {
+        /// The pair.
+        functional: KFunctional,
+        /// σ.
+        sigma: f64,
+    },
+    /// `homega`: Algorithm A ([`omega_continuation`]).
+    OmegaContinuation,
+}
+
+impl Default for SmoothFunctional {
+    fn default() -> Self {
+        SmoothFunctional::BlockSmoothing {
+            sigma: 0.1,
+            density: 1.0,
+            layers: 2,
+        }
+    }
+}
+
+impl FromStr for SmoothFunctional {
+    type Err = OptimError;
+    fn from_str(s: &str) -> Result<Self, OptimError> {
+        let k = |functional| SmoothFunctional::AdaptiveK {
+            functional,
+            sigma: 0.5,
+        };
+        Ok(match s {
+            "ao-homega" => SmoothFunctional::default(),
+            "karea-length" => k(KFunctional::KAreaLength),
+            "ksmooth-area" => k(KFunctional::KSmoothArea),
+            "karea" => k(KFunctional::KArea),
+            "ksmooth" => k(KFunctional::KSmoothness),
+            "homega" => SmoothFunctional::OmegaContinuation,
+            _ => {
+                return Err(OptimError::UnknownName {
+                    what: "functional",
+                    name: s.to_string(),
+                    expected: "ao-homega, karea-length, ksmooth-area, karea, ksmooth, homega",
+                })
+            }
+        })
+    }
+}
+
+/// Options of [`smooth`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SmoothOptions {
+    /// The functional / driver.
+    pub functional: SmoothFunctional,
+    /// The solver and its stopping options (every phase uses this solver).
+    pub solver: SolverOptions,
+    /// ε of the ε-convexity target (`α₋ > ε·ᾱ`; adaptive-k uses `k* = −ε`).
+    pub eps: f64,
+    /// Length pre-smoothing iterations (adaptive-k and untangling; 0 = none).
+    pub presmooth: usize,
+    /// Solver iterations per `k` update (0 = 5 for truncated Newton, 10 otherwise).
+    pub iters_per_k: usize,
+    /// Maximum `k` updates.
+    pub max_k_updates: usize,
+}
+
+impl Default for SmoothOptions {
+    fn default() -> Self {
+        Self {
+            functional: SmoothFunctional::default(),
+            solver: SolverOptions::default(),
+            eps: 0.01,
+            presmooth: 0,
+            iters_per_k: 0,
+            max_k_updates: 2000,
+        }
+    }
+}
+
+impl SmoothOptions {
+    fn adaptive(&self, functional: KFunctional, sigma: f64, classic: bool) -> AdaptiveKOptions {
+        let ipk = if self.iters_per_k > 0 {
+            self.iters_per_k
+        } else if matches!(self.solver.solver, Solver::TnTr | Solver::TnLs) {
+            5
+        } else {
+            10
+        };
+        AdaptiveKOptions {
+            functional,
+            sigma,
+            k_star: -self.eps,
+            iters_per_k: ipk,
+            max_updates: self.max_k_updates,
+            presmooth: self.presmooth,
+            classic,
+            solver: self.solver.clone(),
+        }
+    }
+}
+
+/// Smooths (and, if needed, untangles) a quad mesh in place: the free nodes of `mesh` are
+/// moved, fixed nodes stay. Returns the report; an error only for invalid input (no free
+/// nodes, non-finite coordinates, invalid options, a boundary enclosing no area).
+pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
+    mesh: &mut M,
+    opts: &SmoothOptions,
+    observer: &mut dyn Observer,
+) -> Result<SmoothReport, OptimError> {
+    let topo = Arc::new(QuadTopology::from_mesh(&*mesh)?);
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    let mut x = topo.initial_x();
+    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let mut session = Session::new(&probe, &x, observer);
+    let rep = match &opts.functional {
+        SmoothFunctional::BlockSmoothing {
+            sigma,
+            density,
+            layers,
+        } => {
+            let bo = BlockSmoothingOptions {
+                sigma: *sigma,
+                density: *density,
+                layers: *layers,
+                eps: opts.eps,
+                untangle: opts.adaptive(KFunctional::KAreaLength, 0.5, false),
+                solver: opts.solver.clone(),
+            };
+            block_smoothing(&topo, &mut x, &bo, &mut session)?
+        }
+        SmoothFunctional::AdaptiveK { functional, sigma } => adaptive_k(
+            &topo,
+            &mut x,
+            &opts.adaptive(*functional, *sigma, true),
+            &mut session,
+        )?,
+        SmoothFunctional::OmegaContinuation => {
+            let oo = OmegaOptions {
+                eps: opts.eps,
+                solver: opts.solver.clone(),
+                ..OmegaOptions::default()
+            };
+            omega_continuation(&topo, &mut x, &oo, &mut session)?
+        }
+    };
+    topo.scatter(&x, mesh.nodes_mut());
+    Ok(rep)
+}
+
+/// Which hexahedral driver [`smooth_hex`] runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum HexDriver {
+    /// Algorithm A only.
+    #[default]
+    AlgorithmA,
+    /// Algorithm A, then Algorithm B (if A reached convexity).
+    AlgorithmAB,
+}
+
+/// Options of [`smooth_hex`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct HexSmoothOptions {
+    /// Which algorithms.
+    pub driver: HexDriver,
+    /// Tetrahedron scaling of `H_ω`.
+    pub scaling: Scaling3,
+    /// Algorithm A options (ε default 10⁻⁴ here, seed 004 Tables 3.1–3.2).
+    pub omega: OmegaOptions,
+    /// Algorithm B options.
+    pub coplanarity: CoplanarityOptions,
+}
+
+impl Default for HexSmoothOptions {
+    fn default() -> Self {
+        Self {
+            driver: HexDriver::AlgorithmA,
+            scaling: Scaling3::Index,
+            omega: OmegaOptions {
+                eps: 1e-4,
+                ..OmegaOptions::default()
+            },
+            coplanarity: CoplanarityOptions::default(),
+        }
+    }
+}
+
+/// The hexahedral counterpart of [`smooth`]: Algorithm A (and optionally B) in place.
+/// The returned report is Algorithm B's when it ran (its iteration counters include A's).
+pub fn smooth_hex<M: HasHexCells + FreeNodes + ?Sized>(
+    mesh: &mut M,
+    opts: &HexSmoothOptions,
+    observer: &mut dyn Observer,
+) -> Result<SmoothReport, OptimError> {
+    let topo = Arc::new(HexTopology::from_mesh(&*mesh)?);
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    let mut x = topo.initial_x();
+    let probe = HexFunctional::h_omega(topo.clone(), 1.0, opts.scaling)?;
+    let mut session = Session::new(&probe, &x, observer);
+    let mut rep = omega_continuation_hex(&topo, opts.scaling, &mut x, &opts.omega, &mut session)?;
+    if opts.driver == HexDriver::AlgorithmAB && rep.convex && rep.status.convex() == Some(true) {
+        let a_msgs = rep.messages.clone();
+        let b =
+            coplanarity_continuation(&topo, opts.scaling, &mut x, &opts.coplanarity, &mut session)?;
+        let mut msgs = a_msgs;
+        msgs.extend(b.messages.iter().skip(1).copied());
+        rep = SmoothReport {
+            messages: msgs,
+            initial_alfamin: rep.initial_alfamin,
+            initial_inocon: rep.initial_inocon,
+            eps: rep.eps,
+            eps_convex: b.alfamin > rep.eps * b.alpha_bar,
+            ..b
+        };
+    }
+    topo.scatter(&x, mesh.nodes_mut());
+    Ok(rep)
+}

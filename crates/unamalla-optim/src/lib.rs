@@ -1,0 +1,92 @@
+//! # unamalla-optim
+//!
+//! The optimization stage of unamalla: solvers for the discrete functionals of
+//! `unamalla-functionals` and the continuation drivers that make meshes convex and smooth.
+//! Design follows `argmin`'s separation: a [`Problem`](unamalla_functionals::Problem)
+//! (value, gradient, sparse Hessian / Hessian-vector product, local models, element
+//! measures), a solver ([`solver`]), an observer ([`monitor`]).
+//!
+//! ## Solvers ([`solver`]; seed 001 digest §3 and App. B)
+//! * **Truncated Newton, trust region** ([`Solver::TnTr`], UNAMALLA's default; the TRON family
+//!   of seed 000 §5.5 and seed 004 §3.3): preconditioned Steihaug–Toint CG in the `M`-norm,
+//!   negative-curvature exit to the boundary, forcing sequence
+//!   `η_k = min(η_max, √(‖g_k‖/‖g₀‖))`, radius update on `ρ = ared/pred`.
+//! * **Truncated Newton, line search** ([`Solver::TnLs`]): the same inner CG (negative
+//!   curvature: stop, or preconditioned steepest descent at the first inner iteration) and a
+//!   Moré–Thuente line search ([`linesearch`], a port of MINPACK-2 `dcsrch`).
+//! * **L-BFGS(m)** ([`Solver::Lbfgs`], two-loop recursion, `m` = 3 or 5 in UNAMALLA, any `m`).
+//! * **Pointwise Newton** ([`Solver::Pointwise`], García; seed 001 §B.5.2): Gauss–Seidel
+//!   sweeps over the free nodes, each solving the local 2×2 (3×3) Newton system
+//!   ("simultaneous") or one coordinate at a time ("by components"), with an Armijo test on
+//!   the local value. Nodes are coloured (no two nodes of a colour share a cell), so each
+//!   colour is updated in parallel and the result equals a sequential sweep in colour order.
+//!
+//! Preconditioners ([`linalg::Preconditioner`]): none, Jacobi, block-Jacobi (node blocks of
+//! the assembled CSR Hessian; default). Hessian products use the assembled CSR matrix
+//! (refreshed once per outer iteration) or matrix-free `Problem::hess_vec`.
+//!
+//! **Why not `argmin`.** The solvers are written here, not taken from `argmin` 0.11, for
+//! correctness reasons: every trial point must pass the convexity safeguard below (argmin's
+//! line searches and trust regions have no hook to reject a point short of returning `+∞`,
+//! which its Moré–Thuente does not handle), its `NewtonCG` has no preconditioner and its
+//! `MoreThuente` can panic with "not a descent direction" (reference notes §5), and the
+//! MINPACK-2 failure codes are needed verbatim for the UNAMALLA messages. No timing comparison
+//! with `argmin` was made.
+//!
+//! ## Safeguard (the convexity contract)
+//! A [`Session`](monitor::Session) finds the elements with at least one free vertex (by
+//! perturbing the variables) and, whenever the current iterate has all of them above a
+//! threshold (0, or `ε·ᾱ` in the ε-convex phases), rejects trial points that do not (line
+//! search: bisection toward the best point; trust region: `ρ = −∞`; pointwise: the node step
+//! is halved, checked locally with [`solver::QuadLocalGuard`] or, for hexahedra, by a global
+//! check with backtracking of the sweep). Hence a convex start stays convex. Elements whose
+//! vertices are all fixed are boundary data: they are excluded and counted separately.
+//!
+//! ## Stopping and status ([`status`]; seed 001 digest §7.3, Table A.2)
+//! FTOL (relative decrease of F), GTOL (‖g‖ relative to the first gradient, or absolute),
+//! MAXITER, stop by the observer, line-search failures (xtol, rounding, STPMIN, STPMAX, FCN
+//! calls) and trust-radius collapse. [`Status`]'s `Display` prints the UNAMALLA messages.
+//!
+//! ## Observer ([`monitor`]; Table A.1)
+//! Every iteration the observer receives a [`Monitor`]: Alfamin (α₋), ᾱ,
+//! Kcurrent/Kold (k/ᾱ), ω, μ, Inocon, F, ‖g‖, IterSmooth/IterHomotopic/IterClassic, elapsed
+//! time; it may stop the run. [`ProgressObserver`] prints one
+//! updating line to stderr.
+//!
+//! ## Drivers ([`drivers`])
+//! * [`adaptive_k`](drivers::adaptive_k): seed 001 Algorithms 4.1/4.2 with the practical update
+//!   `k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01` (§2.5, (4.35)), a few iterations per `k`,
+//!   the C² continuation below `α̂` (erratum 6), the double homotopy `σ̂(k)` (5.20), optional
+//!   Length pre-smoothing, then the classic phase.
+//! * [`omega_continuation`](drivers::omega_continuation) /
+//!   [`omega_continuation_hex`](drivers::omega_continuation_hex): seed 004 §3.4 Algorithm A.
+//! * [`coplanarity_continuation`](drivers::coplanarity_continuation): seed 004 §4.2
+//!   Algorithm B.
+//! * [`block_smoothing`](drivers::block_smoothing): seed 000 §5.5 (6.8)/(6.9) with the
+//!   ε-convexity guarantee.
+//! * [`smooth`] / [`smooth_hex`]: the entry points used by `unamalla smooth`.
+//!
+//! ## Fixtures ([`fixtures`])
+//! The seed 001 §5 test regions (`cuad2pp`, the one-hole contour, Ivanenko's region) as TFI
+//! grids, and the sinusoidal benchmark region.
+
+#![warn(missing_docs)]
+
+pub mod drivers;
+pub mod error;
+pub mod fixtures;
+pub mod linalg;
+pub mod linesearch;
+pub mod monitor;
+pub mod solver;
+pub mod status;
+
+pub use drivers::{
+    smooth, smooth_hex, HexDriver, HexSmoothOptions, KFunctional, SmoothFunctional, SmoothOptions,
+    SmoothReport,
+};
+pub use error::OptimError;
+pub use linalg::Preconditioner;
+pub use monitor::{Control, Monitor, NullObserver, Observer, Phase, ProgressObserver};
+pub use solver::{minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions};
+pub use status::{LineSearchFailure, Status, StopReason};

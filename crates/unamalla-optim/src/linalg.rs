@@ -1,0 +1,233 @@
+//! Dense vector kernels (parallel above a size threshold) and the CG preconditioners.
+
+use rayon::prelude::*;
+use unamalla_functionals::Csr;
+
+const PAR: usize = 1 << 15;
+
+/// `xᵀy`.
+pub fn dot(x: &[f64], y: &[f64]) -> f64 {
+    if x.len() >= PAR {
+        x.par_chunks(8192)
+            .zip(y.par_chunks(8192))
+            .map(|(a, b)| dot_serial(a, b))
+            .sum()
+    } else {
+        dot_serial(x, y)
+    }
+}
+
+fn dot_serial(x: &[f64], y: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    let n = x.len() / 4 * 4;
+    for i in (0..n).step_by(4) {
+        for k in 0..4 {
+            s[k] += x[i + k] * y[i + k];
+        }
+    }
+    let mut t = (s[0] + s[1]) + (s[2] + s[3]);
+    for i in n..x.len() {
+        t += x[i] * y[i];
+    }
+    t
+}
+
+/// `‖x‖₂`.
+pub fn norm(x: &[f64]) -> f64 {
+    dot(x, x).sqrt()
+}
+
+/// `y ← y + a·x`.
+pub fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
+    if y.len() >= PAR {
+        y.par_chunks_mut(8192)
+            .zip(x.par_chunks(8192))
+            .for_each(|(yy, xx)| yy.iter_mut().zip(xx).for_each(|(y, x)| *y += a * x));
+    } else {
+        y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
+    }
+}
+
+/// `z ← x + a·y`.
+pub fn add_scaled(x: &[f64], a: f64, y: &[f64], z: &mut [f64]) {
+    if z.len() >= PAR {
+        z.par_chunks_mut(8192)
+            .zip(x.par_chunks(8192).zip(y.par_chunks(8192)))
+            .for_each(|(zz, (xx, yy))| {
+                for i in 0..zz.len() {
+                    zz[i] = xx[i] + a * yy[i];
+                }
+            });
+    } else {
+        for i in 0..z.len() {
+            z[i] = x[i] + a * y[i];
+        }
+    }
+}
+
+/// `y ← a·y + x`.
+pub fn scale_add(a: f64, y: &mut [f64], x: &[f64]) {
+    if y.len() >= PAR {
+        y.par_chunks_mut(8192)
+            .zip(x.par_chunks(8192))
+            .for_each(|(yy, xx)| yy.iter_mut().zip(xx).for_each(|(y, x)| *y = a * *y + x));
+    } else {
+        y.iter_mut().zip(x).for_each(|(y, x)| *y = a * *y + x);
+    }
+}
+
+/// The preconditioner of the inner CG of truncated Newton.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum Preconditioner {
+    /// None (plain CG, as argmin's `NewtonCG`).
+    None,
+    /// Jacobi: `M = diag(|H_ii|)`.
+    Jacobi,
+    /// Block-Jacobi: `M` = the `dim × dim` diagonal node blocks of `H` (falls back to
+    /// `diag(|H_ii|)` on a block that is not positive definite).
+    #[default]
+    BlockJacobi,
+}
+
+/// An applied preconditioner: `M⁻¹` stored per node block (`dim²` entries per node).
+#[derive(Debug, Clone, Default)]
+pub struct PrecondApply {
+    dim: usize,
+    inv: Vec<f64>,
+    kind: Option<Preconditioner>,
+}
+
+impl PrecondApply {
+    /// Rebuilds `M⁻¹` from the assembled Hessian `h` (node blocks of size `dim`).
+    pub fn build(&mut self, kind: Preconditioner, h: &Csr, dim: usize) {
+        self.kind = Some(kind);
+        self.dim = dim;
+        let n = h.nrows;
+        let nb = n / dim;
+        let d2 = dim * dim;
+        self.inv.resize(nb * d2, 0.0);
+        let floor = {
+            let mut m = 0.0f64;
+            for r in 0..n {
+                m = m.max(h.get(r, r).abs());
+            }
+            (m * 1e-12).max(f64::MIN_POSITIVE)
+        };
+        let jac = |r: usize| 1.0 / h.get(r, r).abs().max(floor);
+        match kind {
+            Preconditioner::None => {}
+            Preconditioner::Jacobi => {
+                self.inv.par_chunks_mut(d2).enumerate().for_each(|(b, m)| {
+                    m.iter_mut().for_each(|v| *v = 0.0);
+                    for a in 0..dim {
+                        m[a * dim + a] = jac(b * dim + a);
+                    }
+                });
+            }
+            Preconditioner::BlockJacobi => {
+                self.inv.par_chunks_mut(d2).enumerate().for_each(|(b, m)| {
+                    let mut blk = [[0.0; 3]; 3];
+                    for (a, row) in blk.iter_mut().enumerate().take(dim) {
+                        let r = b * dim + a;
+                        let (s, e) = (h.row_offsets[r], h.row_offsets[r + 1]);
+                        for k in s..e {
+                            let c = h.col_indices[k] as usize;
+                            if c / dim == b {
+                                row[c - b * dim] = h.values[k];
+                            }
+                        }
+                    }
+                    let ok = match dim {
+                        2 => {
+                            let (p, q, r) = (blk[0][0], 0.5 * (blk[0][1] + blk[1][0]), blk[1][1]);
+                            let det = p * r - q * q;
+                            if p > 0.0 && det > 1e-14 * p * r {
+                                m[0] = r / det;
+                                m[1] = -q / det;
+                                m[2] = -q / det;
+                                m[3] = p / det;
+                                true
+                            } else {
+                                false
+                            }
+                        }
+                        3 => match inv3_spd(&blk) {
+                            Some(inv) => {
+                                for a in 0..3 {
+                                    for c in 0..3 {
+                                        m[a * 3 + c] = inv[a][c];
+                                    }
+                                }
+                                true
+                            }
+                            None => false,
+                        },
+                        _ => false,
+                    };
+                    if !ok {
+                        m.iter_mut().for_each(|v| *v = 0.0);
+                        for a in 0..dim {
+                            m[a * dim + a] = 1.0 / blk[a][a].abs().max(floor);
+                        }
+                    }
+                });
+            }
+        }
+    }
+
+    /// `z = M⁻¹ r`.
+    pub fn apply(&self, r: &[f64], z: &mut [f64]) {
+        match self.kind {
+            None | Some(Preconditioner::None) => z.copy_from_slice(r),
+            Some(_) => {
+                let d = self.dim;
+                let d2 = d * d;
+                z.par_chunks_mut(d * 1024)
+                    .zip(r.par_chunks(d * 1024))
+                    .enumerate()
+                    .for_each(|(ch, (zz, rr))| {
+                        let b0 = ch * 1024;
+                        for (lb, (zb, rb)) in zz.chunks_mut(d).zip(rr.chunks(d)).enumerate() {
+                            let m = &self.inv[(b0 + lb) * d2..(b0 + lb + 1) * d2];
+                            for a in 0..d {
+                                let mut acc = 0.0;
+                                for c in 0..d {
+                                    acc += m[a * d + c] * rb[c];
+                                }
+                                zb[a] = acc;
+                            }
+                        }
+                    });
+            }
+        }
+    }
+}
+
+/// Inverse of a symmetric 3×3 matrix if it is positive definite (Cholesky test).
+pub(crate) fn inv3_spd(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let s = |i: usize, j: usize| 0.5 * (a[i][j] + a[j][i]);
+    let l00 = s(0, 0);
+    if l00 <= 0.0 {
+        return None;
+    }
+    let m1 = s(0, 0) * s(1, 1) - s(0, 1) * s(0, 1);
+    let det = s(0, 0) * (s(1, 1) * s(2, 2) - s(1, 2) * s(1, 2))
+        - s(0, 1) * (s(0, 1) * s(2, 2) - s(1, 2) * s(0, 2))
+        + s(0, 2) * (s(0, 1) * s(1, 2) - s(1, 1) * s(0, 2));
+    let scale = s(0, 0) * s(1, 1) * s(2, 2);
+    if m1 <= 1e-14 * s(0, 0) * s(1, 1) || det <= 1e-14 * scale {
+        return None;
+    }
+    let c = |i: usize, j: usize| {
+        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+        s(r0, c0) * s(r1, c1) - s(r0, c1) * s(r1, c0)
+    };
+    let mut inv = [[0.0; 3]; 3];
+    for (i, row) in inv.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = c(j, i) / det;
+        }
+    }
+    Some(inv)
+}

@@ -1,0 +1,466 @@
+//! The monitor (seed 001 digest §7.3, Table A.1), observers, and the per-run bookkeeping that
+//! measures convexity and enforces the domain safeguard.
+
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use unamalla_functionals::Problem;
+
+/// The phase a driver is in (the three iteration counters of Table A.1, plus the continuation
+/// phases of seed 004).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum Phase {
+    /// Pre-smoothing with Length ("IterSmooth").
+    Smooth,
+    /// Homotopy / continuation phase ("IterHomotopic"): adaptive k, ω-halving, μ-continuation.
+    Homotopic,
+    /// Classic / refinement phase ("IterClassic").
+    #[default]
+    Classic,
+}
+
+/// What an observer sees every iteration (Table A.1 fields).
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Monitor {
+    /// "Alfamin": `α₋`, the minimum measure over the elements with at least one free vertex
+    /// (corner-triangle α in 2D, tetrahedron Jacobian in 3D).
+    pub alfamin: f64,
+    /// `ᾱ`, the mean measure over all elements.
+    pub alpha_bar: f64,
+    /// "Kcurrent": `k/ᾱ` of the adaptive driver (`None` outside it).
+    pub k_current: Option<f64>,
+    /// "Kold": the previous `k/ᾱ`.
+    pub k_old: Option<f64>,
+    /// Current `ω` (Algorithm A, (6.8)); `None` if not applicable.
+    pub omega: Option<f64>,
+    /// Current `μ` of the coplanarity continuation (Algorithm B).
+    pub mu: Option<f64>,
+    /// "Inocon": cells with an element (with a free vertex) of measure `≤ 0`.
+    pub inocon: usize,
+    /// Elements whose vertices are all fixed and whose measure is `≤ 0` (boundary data,
+    /// reported separately).
+    pub fixed_nonpositive: usize,
+    /// "Fvalue".
+    pub f: f64,
+    /// "Gnorm": Euclidean norm of the gradient.
+    pub gnorm: f64,
+    /// "IterSmooth".
+    pub iter_smooth: usize,
+    /// "IterHomotopic".
+    pub iter_homotopic: usize,
+    /// "IterClassic".
+    pub iter_classic: usize,
+    /// The current phase.
+    pub phase: Phase,
+    /// "Process Time".
+    pub elapsed: Duration,
+}
+
+impl Monitor {
+    /// `α₋/ᾱ`.
+    pub fn alfamin_rel(&self) -> f64 {
+        self.alfamin / self.alpha_bar
+    }
+    /// Total iterations over the phases.
+    pub fn total_iterations(&self) -> usize {
+        self.iter_smooth + self.iter_homotopic + self.iter_classic
+    }
+}
+
+/// What an observer wants after an iteration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Control {
+    /// Go on.
+    Continue,
+    /// Stop the run (reported as "STOP by user").
+    Stop,
+}
+
+/// Called after every iteration of every solver with the current [`Monitor`]; can stop the run.
+pub trait Observer {
+    /// Inspect the monitor; return [`Control::Stop`] to stop.
+    fn observe(&mut self, monitor: &Monitor) -> Control;
+}
+
+impl<F: FnMut(&Monitor) -> Control> Observer for F {
+    fn observe(&mut self, monitor: &Monitor) -> Control {
+        self(monitor)
+    }
+}
+
+/// An observer that does nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NullObserver;
+
+impl Observer for NullObserver {
+    fn observe(&mut self, _: &Monitor) -> Control {
+        Control::Continue
+    }
+}
+
+/// Prints one updating progress line to stderr (`\r`-rewritten, at most every `interval`):
+/// phase, iteration, Alfamin (as `α₋/ᾱ`), Inocon, F, ‖g‖, k/ᾱ or ω, elapsed time. Call
+/// [`finish`](Self::finish) to end the line.
+#[derive(Debug)]
+pub struct ProgressObserver {
+    interval: Duration,
+    last: Option<Instant>,
+    printed: bool,
+}
+
+impl Default for ProgressObserver {
+    fn default() -> Self {
+        Self::new(Duration::from_millis(100))
+    }
+}
+
+impl ProgressObserver {
+    /// Refreshes at most once per `interval`.
+    pub fn new(interval: Duration) -> Self {
+        Self {
+            interval,
+            last: None,
+            printed: false,
+        }
+    }
+    /// The progress line for a monitor.
+    pub fn line(m: &Monitor) -> String {
+        let phase = match m.phase {
+            Phase::Smooth => "smooth",
+            Phase::Homotopic => "homot.",
+            Phase::Classic => "classic",
+        };
+        let extra = if let Some(k) = m.k_current {
+            format!(" k/ᾱ {k:+.4}")
+        } else if let Some(mu) = m.mu {
+            format!(" μ {mu:.1e}")
+        } else if let Some(w) = m.omega {
+            format!(" ω {w:.2e}")
+        } else {
+            String::new()
+        };
+        format!(
+            "{phase} it {:>5} | Alfamin/ᾱ {:+.4e} | Inocon {:>6} | F {:.6e} | ‖g‖ {:.3e}{extra} | {:.2}s",
+            m.total_iterations(),
+            m.alfamin_rel(),
+            m.inocon,
+            m.f,
+            m.gnorm,
+            m.elapsed.as_secs_f64()
+        )
+    }
+    /// Ends the progress line with a newline (if anything was printed).
+    pub fn finish(&mut self) {
+        if self.printed {
+            eprintln!();
+            self.printed = false;
+        }
+    }
+}
+
+impl Observer for ProgressObserver {
+    fn observe(&mut self, m: &Monitor) -> Control {
+        let now = Instant::now();
+        if self
+            .last
+            .is_none_or(|t| now.duration_since(t) >= self.interval)
+        {
+            self.last = Some(now);
+            let mut e = std::io::stderr().lock();
+            let _ = write!(e, "\r{}\x1b[K", Self::line(m));
+            let _ = e.flush();
+            self.printed = true;
+        }
+        Control::Continue
+    }
+}
+
+/// A record of every monitor seen (for tests and tables).
+#[derive(Debug, Clone, Default)]
+pub struct HistoryObserver {
+    /// The monitors, in order.
+    pub history: Vec<Monitor>,
+}
+
+impl Observer for HistoryObserver {
+    fn observe(&mut self, m: &Monitor) -> Control {
+        self.history.push(m.clone());
+        Control::Continue
+    }
+}
+
+/// Convexity statistics of an iterate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Convexity {
+    /// Minimum measure over elements with a free vertex (`+∞` if there is none).
+    pub min: f64,
+    /// Mean measure over all elements (`ᾱ`).
+    pub mean: f64,
+    /// Cells with a free-vertex element of measure `≤ 0`.
+    pub nonconvex_cells: usize,
+    /// Elements with all vertices fixed and measure `≤ 0`.
+    pub fixed_nonpositive: usize,
+    /// Minimum over the all-fixed elements (`+∞` if none).
+    pub fixed_min: f64,
+}
+
+impl Convexity {
+    /// Every element with a free vertex has a positive measure.
+    pub fn convex(&self) -> bool {
+        self.min > 0.0
+    }
+    /// `α₋ > ε·ᾱ`.
+    pub fn eps_convex(&self, eps: f64) -> bool {
+        self.min > eps * self.mean
+    }
+}
+
+/// Per-run state shared by solvers and drivers: the observer, the monitor, the clock, the
+/// element mask (elements with a free vertex) and the domain safeguard.
+///
+/// The safeguard: when the current iterate has every masked element above
+/// [`guard_threshold`](Self::guard_threshold) (0 by default, i.e. convex), trial points
+/// with a masked element at or below the threshold are rejected by the line searches, trust
+/// regions and pointwise steps. So a convex (ε-convex) start never becomes non-convex.
+pub struct Session<'o> {
+    observer: &'o mut dyn Observer,
+    start: Instant,
+    /// The monitor (phase counters accumulate over solver runs).
+    pub monitor: Monitor,
+    mask: Vec<bool>,
+    group: usize,
+    meas: Vec<f64>,
+    /// Absolute threshold of the safeguard (see the type docs).
+    pub guard_threshold: f64,
+    /// Whether the safeguard is on.
+    pub guard: bool,
+    stop: bool,
+    pub(crate) hess: Option<unamalla_functionals::Csr>,
+    pub(crate) colors: Option<Vec<Vec<usize>>>,
+}
+
+impl std::fmt::Debug for Session<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session")
+            .field("monitor", &self.monitor)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'o> Session<'o> {
+    /// A session for `problem` (the element mask is found by perturbing the free variables of
+    /// `x`: elements whose measure does not change have only fixed vertices).
+    pub fn new<P: Problem + ?Sized>(
+        problem: &P,
+        x: &[f64],
+        observer: &'o mut dyn Observer,
+    ) -> Self {
+        let ne = problem.num_elements();
+        let mut a = vec![0.0; ne];
+        let mut b = vec![0.0; ne];
+        problem.element_measures(x, &mut a);
+        let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1.0) * 1e-3;
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let xp: Vec<f64> = x
+            .iter()
+            .map(|v| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                v + scale * (0.5 + (state >> 11) as f64 / (1u64 << 53) as f64)
+            })
+            .collect();
+        problem.element_measures(&xp, &mut b);
+        let mask = a.iter().zip(&b).map(|(p, q)| p != q).collect();
+        Self {
+            observer,
+            start: Instant::now(),
+            monitor: Monitor::default(),
+            mask,
+            group: if problem.dim() == 3 { 10 } else { 4 },
+            meas: a,
+            guard_threshold: 0.0,
+            guard: true,
+            stop: false,
+            hess: None,
+            colors: None,
+        }
+    }
+
+    /// The element mask (`true` = the element has a free vertex).
+    pub fn mask(&self) -> &[bool] {
+        &self.mask
+    }
+
+    /// Convexity statistics at `x`.
+    pub fn convexity<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64]) -> Convexity {
+        problem.element_measures(x, &mut self.meas);
+        let mut c = Convexity {
+            min: f64::INFINITY,
+            mean: 0.0,
+            nonconvex_cells: 0,
+            fixed_nonpositive: 0,
+            fixed_min: f64::INFINITY,
+        };
+        let mut sum = 0.0;
+        for (cell, mk) in self
+            .meas
+            .chunks(self.group)
+            .zip(self.mask.chunks(self.group))
+        {
+            let mut bad = false;
+            for (&v, &m) in cell.iter().zip(mk) {
+                sum += v;
+                if m {
+                    c.min = c.min.min(v);
+                    if v.is_nan() || v <= 0.0 {
+                        bad = true;
+                    }
+                } else {
+                    c.fixed_min = c.fixed_min.min(v);
+                    if v <= 0.0 {
+                        c.fixed_nonpositive += 1;
+                    }
+                }
+            }
+            c.nonconvex_cells += bad as usize;
+        }
+        if c.min.is_nan() {
+            c.min = f64::NEG_INFINITY;
+        }
+        c.mean = sum / self.meas.len().max(1) as f64;
+        c
+    }
+
+    /// Minimum masked measure at `x` (NaN measures count as `−∞`).
+    pub fn masked_min<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64]) -> f64 {
+        problem.element_measures(x, &mut self.meas);
+        let mut m = f64::INFINITY;
+        for (&v, &k) in self.meas.iter().zip(&self.mask) {
+            if k {
+                if v.is_nan() {
+                    return f64::NEG_INFINITY;
+                }
+                m = m.min(v);
+            }
+        }
+        m
+    }
+
+    /// Whether the safeguard applies at the current iterate whose masked minimum is `cur_min`.
+    pub fn guard_active(&self, cur_min: f64) -> bool {
+        self.guard && cur_min > self.guard_threshold
+    }
+
+    /// `true` if `x_trial` keeps every masked element above the threshold.
+    pub fn admissible<P: Problem + ?Sized>(&mut self, problem: &P, x_trial: &[f64]) -> bool {
+        self.masked_min(problem, x_trial) > self.guard_threshold
+    }
+
+    /// Fraction-to-boundary step: the largest `t > 0` such that every masked element stays
+    /// above the threshold on `[0, t)` along `x + t·d`, computed exactly in 2D (α is quadratic
+    /// in `t`: three evaluations at `t = −1, 0, 1`); `+∞` in 3D (where the search bisects).
+    pub fn max_step<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64], d: &[f64]) -> f64 {
+        if problem.dim() != 2 {
+            return f64::INFINITY;
+        }
+        let ne = self.meas.len();
+        let mut a0 = std::mem::take(&mut self.meas);
+        let mut ap = vec![0.0; ne];
+        let mut am = vec![0.0; ne];
+        let mut xt: Vec<f64> = x.iter().zip(d).map(|(a, b)| a + b).collect();
+        problem.element_measures(x, &mut a0);
+        problem.element_measures(&xt, &mut ap);
+        xt.iter_mut()
+            .zip(x.iter().zip(d))
+            .for_each(|(t, (a, b))| *t = a - b);
+        problem.element_measures(&xt, &mut am);
+        let thr = self.guard_threshold;
+        let mut tmax = f64::INFINITY;
+        for i in 0..ne {
+            if !self.mask[i] {
+                continue;
+            }
+            let c = a0[i] - thr;
+            if c <= 0.0 {
+                continue;
+            }
+            let b = 0.5 * (ap[i] - am[i]);
+            let a = 0.5 * (ap[i] + am[i]) - a0[i];
+            let t = if a.abs() <= 1e-14 * (b.abs() + c) {
+                if b < 0.0 {
+                    -c / b
+                } else {
+                    f64::INFINITY
+                }
+            } else {
+                let disc = b * b - 4.0 * a * c;
+                if disc < 0.0 {
+                    f64::INFINITY
+                } else {
+                    let q = -0.5 * (b + b.signum() * disc.sqrt());
+                    let (r1, r2) = (q / a, c / q);
+                    let mut r = f64::INFINITY;
+                    for v in [r1, r2] {
+                        if v > 0.0 && v < r {
+                            r = v;
+                        }
+                    }
+                    r
+                }
+            };
+            tmax = tmax.min(t);
+        }
+        self.meas = a0;
+        tmax
+    }
+
+    /// Sets the phase of the following iterations.
+    pub fn set_phase(&mut self, phase: Phase) {
+        self.monitor.phase = phase;
+    }
+
+    /// Elapsed time since the session started.
+    pub fn elapsed(&self) -> Duration {
+        self.start.elapsed()
+    }
+
+    /// Whether the observer asked to stop.
+    pub fn stop_requested(&self) -> bool {
+        self.stop
+    }
+
+    /// Records one iteration at `x` with value `f` and gradient norm `gnorm`, notifies the
+    /// observer, and returns its verdict. Returns the convexity statistics for the solver.
+    pub fn iterate<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+        f: f64,
+        gnorm: f64,
+    ) -> (Control, Convexity) {
+        match self.monitor.phase {
+            Phase::Smooth => self.monitor.iter_smooth += 1,
+            Phase::Homotopic => self.monitor.iter_homotopic += 1,
+            Phase::Classic => self.monitor.iter_classic += 1,
+        }
+        let c = self.convexity(problem, x);
+        self.update(c, f, gnorm);
+        let ctl = self.observer.observe(&self.monitor);
+        if ctl == Control::Stop {
+            self.stop = true;
+        }
+        (ctl, c)
+    }
+
+    /// Updates the monitor fields without counting an iteration.
+    pub fn update(&mut self, c: Convexity, f: f64, gnorm: f64) {
+        self.monitor.alfamin = c.min;
+        self.monitor.alpha_bar = c.mean;
+        self.monitor.inocon = c.nonconvex_cells;
+        self.monitor.fixed_nonpositive = c.fixed_nonpositive;
+        self.monitor.f = f;
+        self.monitor.gnorm = gnorm;
+        self.monitor.elapsed = self.start.elapsed();
+    }
+}

@@ -1,0 +1,995 @@
+//! The solvers: truncated Newton with a trust region (Steihaug–CG) or a Moré–Thuente line
+//! search, L-BFGS(m), and pointwise (Gauss–Seidel) Newton (seed 001 digest §3 and App. B;
+//! seed 000 §5.5 and seed 004 §3.3 use TRON, a trust-region truncated Newton).
+//!
+//! All of them work on any [`Problem`] and report every iteration to a [`Session`], which
+//! also enforces the convexity safeguard: when the iterate is convex (every element with a
+//! free vertex above the session's threshold), trial points that are not are rejected.
+
+use std::str::FromStr;
+use std::sync::Arc;
+
+use rayon::prelude::*;
+use unamalla_functionals::{Csr, Problem, QuadTopology};
+
+use crate::error::OptimError;
+use crate::linalg::{
+    add_scaled, axpy, dot, inv3_spd, norm, scale_add, PrecondApply, Preconditioner,
+};
+use crate::linesearch::{more_thuente, LineSearchParams};
+use crate::monitor::{Control, Session};
+use crate::status::{LineSearchFailure, StopReason};
+
+/// The optimization method (names as accepted by `unamalla smooth --solver`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum Solver {
+    /// `tn-tr`: truncated Newton with a trust region (Steihaug–CG, negative-curvature exit);
+    /// UNAMALLA's default and the TRON family of seeds 000/004.
+    #[default]
+    TnTr,
+    /// `tn-ls`: truncated Newton with a Moré–Thuente line search.
+    TnLs,
+    /// `lbfgs`: L-BFGS with memory [`SolverOptions::lbfgs_memory`] (UNAMALLA: 3 or 5).
+    Lbfgs,
+    /// `pointwise`: Gauss–Seidel sweeps of local 2×2 / 3×3 Newton steps (García).
+    Pointwise,
+}
+
+impl Solver {
+    /// All solvers.
+    pub const ALL: [Solver; 4] = [Solver::TnTr, Solver::TnLs, Solver::Lbfgs, Solver::Pointwise];
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::TnTr => "tn-tr",
+            Solver::TnLs => "tn-ls",
+            Solver::Lbfgs => "lbfgs",
+            Solver::Pointwise => "pointwise",
+        }
+    }
+}
+
+impl std::fmt::Display for Solver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Solver {
+    type Err = OptimError;
+    fn from_str(s: &str) -> Result<Self, OptimError> {
+        Solver::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| OptimError::UnknownName {
+                what: "solver",
+                name: s.to_string(),
+                expected: "tn-tr, tn-ls, lbfgs, pointwise",
+            })
+    }
+}
+
+/// Mode of pointwise Newton (UNAMALLA "Newton Point to Point").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum PointwiseMode {
+    /// Solve the local 2×2 (3×3) Newton system.
+    #[default]
+    Simultaneous,
+    /// One-dimensional Newton steps coordinate by coordinate ("by components").
+    Components,
+}
+
+/// How truncated Newton forms Hessian-vector products.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum HessianMode {
+    /// Assemble the sparse Hessian once per outer iteration and multiply (fast; memory
+    /// `≈ 12 bytes × 18 × 2 × free nodes` in 2D).
+    #[default]
+    Assembled,
+    /// Matrix-free products through [`Problem::hess_vec`] (no preconditioner is available
+    /// then; Jacobi/block-Jacobi still use an assembled diagonal only in `Assembled` mode).
+    MatrixFree,
+}
+
+/// Options of one solver run.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SolverOptions {
+    /// The method.
+    pub solver: Solver,
+    /// MAXITER: outer iterations (pointwise: sweeps).
+    pub max_iter: usize,
+    /// FTOL: stop when `(F_old − F) ≤ ftol · max(|F_old|, |F|)`.
+    pub ftol: f64,
+    /// GTOL: stop when `‖g‖ ≤ gtol · ‖g₀‖` (`g₀` = first gradient of the run).
+    pub gtol: f64,
+    /// Absolute GTOL: stop when `‖g‖ ≤ gtol_abs`.
+    pub gtol_abs: f64,
+    /// Preconditioner of the inner CG.
+    pub preconditioner: Preconditioner,
+    /// Hessian products.
+    pub hessian: HessianMode,
+    /// Maximum inner CG iterations per outer iteration.
+    pub cg_max_iter: usize,
+    /// Upper bound of the forcing sequence `η_k = min(forcing_max, √(‖g‖/‖g₀‖))`
+    /// (inner CG stops at `‖r‖ ≤ η_k‖g‖`).
+    pub forcing_max: f64,
+    /// L-BFGS memory `m`.
+    pub lbfgs_memory: usize,
+    /// Pointwise mode.
+    pub pointwise_mode: PointwiseMode,
+    /// Line-search parameters (TN-LS, L-BFGS).
+    pub line_search: LineSearchParams,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        Self {
+            solver: Solver::TnTr,
+            max_iter: 200,
+            ftol: 1e-10,
+            gtol: 1e-6,
+            gtol_abs: 0.0,
+            preconditioner: Preconditioner::BlockJacobi,
+            hessian: HessianMode::Assembled,
+            cg_max_iter: 200,
+            forcing_max: 0.5,
+            lbfgs_memory: 5,
+            pointwise_mode: PointwiseMode::Simultaneous,
+            line_search: LineSearchParams::default(),
+        }
+    }
+}
+
+impl SolverOptions {
+    /// Default options for `solver`.
+    pub fn new(solver: Solver) -> Self {
+        Self {
+            solver,
+            ..Default::default()
+        }
+    }
+    fn validate(&self) -> Result<(), OptimError> {
+        let pos = |name, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(OptimError::InvalidOption {
+                    name,
+                    value: v,
+                    reason: "must be finite and ≥ 0",
+                })
+            }
+        };
+        pos("ftol", self.ftol)?;
+        pos("gtol", self.gtol)?;
+        pos("gtol_abs", self.gtol_abs)?;
+        pos("forcing_max", self.forcing_max)?;
+        if self.lbfgs_memory == 0 {
+            return Err(OptimError::InvalidOption {
+                name: "lbfgs_memory",
+                value: 0.0,
+                reason: "L-BFGS needs m ≥ 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The result of one solver run.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SolveResult {
+    /// Why it stopped.
+    pub reason: StopReason,
+    /// Outer iterations (sweeps for pointwise Newton).
+    pub iterations: usize,
+    /// Final value.
+    pub f: f64,
+    /// Final gradient norm.
+    pub gnorm: f64,
+    /// Function(+gradient) evaluations.
+    pub fevals: usize,
+    /// Inner CG iterations (truncated Newton).
+    pub cg_iterations: usize,
+    /// Final `α₋` over elements with a free vertex.
+    pub alfamin: f64,
+    /// Final `ᾱ`.
+    pub alpha_bar: f64,
+    /// Whether the final point is convex.
+    pub convex: bool,
+}
+
+/// Local convexity check for pointwise Newton on quad meshes: the corner triangles of the
+/// cells around a node, evaluated directly (no global pass).
+#[derive(Debug, Clone)]
+pub struct QuadLocalGuard {
+    topo: Arc<QuadTopology>,
+    offsets: Vec<usize>,
+    cells: Vec<u32>,
+}
+
+impl QuadLocalGuard {
+    /// Builds the node → cells incidence of a topology.
+    pub fn new(topo: Arc<QuadTopology>) -> Self {
+        let n = topo.num_nodes();
+        let mut cnt = vec![0usize; n + 1];
+        for c in 0..topo.num_cells() {
+            for v in topo.cell(c) {
+                cnt[v + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            cnt[i + 1] += cnt[i];
+        }
+        let mut fill = cnt.clone();
+        let mut cells = vec![0u32; cnt[n]];
+        for c in 0..topo.num_cells() {
+            for v in topo.cell(c) {
+                cells[fill[v]] = c as u32;
+                fill[v] += 1;
+            }
+        }
+        Self {
+            topo,
+            offsets: cnt,
+            cells,
+        }
+    }
+
+    /// Minimum α over the corner triangles that contain `node`, at `x`.
+    pub fn node_min_alpha(&self, x: &[f64], node: usize) -> f64 {
+        let pt = |v: usize| match self.topo.var_of(v) {
+            Some(j) => glam::DVec2::new(x[2 * j], x[2 * j + 1]),
+            None => self.topo.coords()[v],
+        };
+        let mut m = f64::INFINITY;
+        for &c in &self.cells[self.offsets[node]..self.offsets[node + 1]] {
+            let cell = self.topo.cell(c as usize);
+            let Some(i) = cell.iter().position(|&v| v == node) else {
+                continue;
+            };
+            let p = cell.map(pt);
+            for k in 0..4 {
+                if k == (i + 2) & 3 {
+                    continue;
+                }
+                let a = (p[(k + 1) & 3] - p[k]).perp_dot(p[(k + 3) & 3] - p[k]);
+                m = m.min(if a.is_nan() { f64::NEG_INFINITY } else { a });
+            }
+        }
+        m
+    }
+}
+
+fn check_start<P: Problem + ?Sized>(problem: &P, x: &[f64]) -> Result<(), OptimError> {
+    if problem.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
+    if x.len() != problem.num_vars() {
+        return Err(OptimError::InvalidOption {
+            name: "x.len()",
+            value: x.len() as f64,
+            reason: "the starting point must have num_vars entries",
+        });
+    }
+    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+        return Err(OptimError::NonFiniteStart { index: i });
+    }
+    Ok(())
+}
+
+/// Minimizes `problem` from `x` (overwritten with the result) with the method of `opts`,
+/// reporting to `session`. Errors only for invalid input (empty problem, non-finite start,
+/// non-finite value or gradient at the start, invalid options); non-convergence is a
+/// [`StopReason`].
+pub fn minimize<P: Problem + ?Sized>(
+    problem: &P,
+    x: &mut [f64],
+    opts: &SolverOptions,
+    session: &mut Session<'_>,
+) -> Result<SolveResult, OptimError> {
+    minimize_with(problem, x, opts, session, None)
+}
+
+/// [`minimize`] with an optional local convexity check for pointwise Newton on quad meshes
+/// (without it, pointwise Newton checks convexity after each sweep and backtracks the sweep).
+pub fn minimize_with<P: Problem + ?Sized>(
+    problem: &P,
+    x: &mut [f64],
+    opts: &SolverOptions,
+    session: &mut Session<'_>,
+    local_guard: Option<&QuadLocalGuard>,
+) -> Result<SolveResult, OptimError> {
+    opts.validate()?;
+    check_start(problem, x)?;
+    let n = x.len();
+    let mut g = vec![0.0; n];
+    let f = problem.value_grad(x, &mut g);
+    if !f.is_finite() || g.iter().any(|v| !v.is_finite()) {
+        return Err(OptimError::NonFiniteValue { value: f });
+    }
+    let mut st = State {
+        f,
+        gnorm: norm(&g),
+        g0norm: 0.0,
+        iterations: 0,
+        fevals: 1,
+        cg: 0,
+        cur_min: 0.0,
+        alpha_bar: 0.0,
+    };
+    st.g0norm = st.gnorm;
+    let c = session.convexity(problem, x);
+    st.cur_min = c.min;
+    st.alpha_bar = c.mean;
+    session.update(c, f, st.gnorm);
+    let reason = if session.stop_requested() {
+        StopReason::User
+    } else if st.gnorm <= opts.gtol_abs || st.gnorm == 0.0 {
+        StopReason::Gtol
+    } else {
+        match opts.solver {
+            Solver::TnTr | Solver::TnLs => {
+                truncated_newton(problem, x, &mut g, opts, session, &mut st)
+            }
+            Solver::Lbfgs => lbfgs(problem, x, &mut g, opts, session, &mut st),
+            Solver::Pointwise => pointwise(problem, x, &mut g, opts, session, &mut st, local_guard),
+        }
+    };
+    Ok(SolveResult {
+        reason,
+        iterations: st.iterations,
+        f: st.f,
+        gnorm: st.gnorm,
+        fevals: st.fevals,
+        cg_iterations: st.cg,
+        alfamin: st.cur_min,
+        alpha_bar: st.alpha_bar,
+        convex: st.cur_min > 0.0,
+    })
+}
+
+struct State {
+    f: f64,
+    gnorm: f64,
+    g0norm: f64,
+    iterations: usize,
+    fevals: usize,
+    cg: usize,
+    cur_min: f64,
+    alpha_bar: f64,
+}
+
+impl State {
+    /// Records an accepted iterate; returns a stop reason if a test fires.
+    #[allow(clippy::too_many_arguments)]
+    fn accept<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+        f_new: f64,
+        gnorm: f64,
+        opts: &SolverOptions,
+        session: &mut Session<'_>,
+        truncated: bool,
+    ) -> Option<StopReason> {
+        let f_old = self.f;
+        self.f = f_new;
+        self.gnorm = gnorm;
+        self.iterations += 1;
+        let (ctl, c) = session.iterate(problem, x, f_new, gnorm);
+        self.cur_min = c.min;
+        self.alpha_bar = c.mean;
+        if ctl == Control::Stop {
+            return Some(StopReason::User);
+        }
+        if gnorm <= opts.gtol * self.g0norm || gnorm <= opts.gtol_abs {
+            return Some(StopReason::Gtol);
+        }
+        // FTOL is not tested after a step cut short by the safeguard (a small decrease there
+        // says nothing about optimality)
+        if !truncated && (f_old - f_new) <= opts.ftol * f_old.abs().max(f_new.abs()) {
+            return Some(StopReason::Ftol);
+        }
+        if self.iterations >= opts.max_iter {
+            return Some(StopReason::MaxIter);
+        }
+        None
+    }
+}
+
+struct CgWork {
+    r: Vec<f64>,
+    y: Vec<f64>,
+    d: Vec<f64>,
+    hd: Vec<f64>,
+    hz: Vec<f64>,
+    z: Vec<f64>,
+}
+
+struct CgOut {
+    gz: f64,
+    zhz: f64,
+    iters: usize,
+    boundary: bool,
+    pred: f64,
+    znorm_m: f64,
+}
+
+/// Preconditioned Steihaug–Toint CG on `H z = −g` inside `‖z‖_M ≤ radius` (radius may be
+/// infinite: plain truncated CG with a negative-curvature exit).
+fn steihaug(
+    hv: &dyn Fn(&[f64], &mut [f64]),
+    g: &[f64],
+    pre: &PrecondApply,
+    radius: f64,
+    tol: f64,
+    maxit: usize,
+    w: &mut CgWork,
+) -> CgOut {
+    let CgWork { r, y, d, hd, hz, z } = w;
+    z.iter_mut().for_each(|v| *v = 0.0);
+    hz.iter_mut().for_each(|v| *v = 0.0);
+    r.copy_from_slice(g);
+    pre.apply(r, y);
+    d.iter_mut().zip(y.iter()).for_each(|(d, y)| *d = -y);
+    let mut ry = dot(r, y);
+    let (mut zmz, mut zmd, mut dmd) = (0.0, 0.0, ry);
+    let mut out = CgOut {
+        gz: 0.0,
+        zhz: 0.0,
+        iters: 0,
+        boundary: false,
+        pred: 0.0,
+        znorm_m: 0.0,
+    };
+    let to_boundary = |zmz: f64, zmd: f64, dmd: f64| {
+        let disc = (zmd * zmd + dmd * (radius * radius - zmz)).max(0.0);
+        (-zmd + disc.sqrt()) / dmd
+    };
+    for it in 0..maxit.max(1) {
+        hv(d, hd);
+        let kappa = dot(d, hd);
+        if kappa.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || !kappa.is_finite() {
+            // negative curvature (or breakdown)
+            if radius.is_finite() {
+                let tau = to_boundary(zmz, zmd, dmd);
+                axpy(tau, d, z);
+                axpy(tau, hd, hz);
+                out.boundary = true;
+            } else if it == 0 {
+                z.copy_from_slice(d);
+                hz.copy_from_slice(hd);
+            }
+            out.iters = it + 1;
+            break;
+        }
+        let a = ry / kappa;
+        let zmz_new = zmz + 2.0 * a * zmd + a * a * dmd;
+        if radius.is_finite() && zmz_new >= radius * radius {
+            let tau = to_boundary(zmz, zmd, dmd);
+            axpy(tau, d, z);
+            axpy(tau, hd, hz);
+            out.boundary = true;
+            out.iters = it + 1;
+            break;
+        }
+        axpy(a, d, z);
+        axpy(a, hd, hz);
+        zmz = zmz_new;
+        axpy(a, hd, r);
+        out.iters = it + 1;
+        if norm(r) <= tol {
+            break;
+        }
+        pre.apply(r, y);
+        let ry_new = dot(r, y);
+        let beta = ry_new / ry;
+        ry = ry_new;
+        zmd = beta * (zmd + a * dmd);
+        dmd = ry + beta * beta * dmd;
+        // d ← −y + β d
+        y.iter_mut().for_each(|v| *v = -*v);
+        scale_add(beta, d, y);
+        y.iter_mut().for_each(|v| *v = -*v);
+    }
+    out.gz = dot(g, z);
+    out.zhz = dot(z, hz);
+    out.pred = -(out.gz + 0.5 * out.zhz);
+    out.znorm_m = zmz.max(0.0).sqrt();
+    if out.boundary {
+        out.znorm_m = radius;
+    }
+    out
+}
+
+fn ensure_hessian<P: Problem + ?Sized>(problem: &P, session: &mut Session<'_>) {
+    let ok = matches!(&session.hess, Some(h) if h.nrows == problem.num_vars());
+    if !ok {
+        session.hess = Some(problem.hessian_pattern());
+    }
+}
+
+fn truncated_newton<P: Problem + ?Sized>(
+    problem: &P,
+    x: &mut [f64],
+    g: &mut [f64],
+    opts: &SolverOptions,
+    session: &mut Session<'_>,
+    st: &mut State,
+) -> StopReason {
+    let n = x.len();
+    let trust = opts.solver == Solver::TnTr;
+    let assembled = opts.hessian == HessianMode::Assembled;
+    if assembled {
+        ensure_hessian(problem, session);
+    }
+    let mut h: Csr = if assembled {
+        session
+            .hess
+            .take()
+            .unwrap_or_else(|| problem.hessian_pattern())
+    } else {
+        Csr {
+            nrows: 0,
+            ncols: 0,
+            row_offsets: vec![0],
+            col_indices: Vec::new(),
+            values: Vec::new(),
+        }
+    };
+    let mut pre = PrecondApply::default();
+    let mut w = CgWork {
+        r: vec![0.0; n],
+        y: vec![0.0; n],
+        d: vec![0.0; n],
+        hd: vec![0.0; n],
+        hz: vec![0.0; n],
+        z: vec![0.0; n],
+    };
+    let mut xt = vec![0.0; n];
+    let mut gt = vec![0.0; n];
+    let mut radius = f64::INFINITY;
+    let reason = 'outer: loop {
+        if assembled {
+            problem.hessian(x, &mut h);
+            pre.build(opts.preconditioner, &h, problem.dim());
+        } else {
+            pre.build(Preconditioner::None, &h, problem.dim());
+        }
+        let eta = opts.forcing_max.min((st.gnorm / st.g0norm).sqrt());
+        let tol = eta * st.gnorm;
+        let xr: &[f64] = x;
+        let hv = |v: &[f64], out: &mut [f64]| {
+            if assembled {
+                h.mul_vec(v, out)
+            } else {
+                problem.hess_vec(xr, v, out)
+            }
+        };
+        let guard = session.guard_active(st.cur_min);
+        let f_acc;
+        let mut truncated;
+        if trust {
+            loop {
+                truncated = false;
+                let mut o = steihaug(&hv, g, &pre, radius, tol, opts.cg_max_iter, &mut w);
+                st.cg += o.iters;
+                if radius.is_infinite() {
+                    radius = o.znorm_m.max(f64::MIN_POSITIVE);
+                }
+                if guard {
+                    // fraction to the boundary of the admissible set
+                    let tm = session.max_step(problem, xr, &w.z);
+                    if tm < 1.0 {
+                        let tau = 0.9 * tm;
+                        w.z.iter_mut().for_each(|v| *v *= tau);
+                        o.pred = -(tau * o.gz + 0.5 * tau * tau * o.zhz);
+                        o.znorm_m *= tau;
+                        o.boundary = false;
+                        // the next model step stays in the smaller ball, bending away from
+                        // the boundary of the admissible set
+                        radius = radius.min(o.znorm_m);
+                        truncated = true;
+                    }
+                }
+                add_scaled(xr, 1.0, &w.z, &mut xt);
+                let ok = !guard || session.admissible(problem, &xt);
+                let ft = if ok {
+                    st.fevals += 1;
+                    problem.value_grad(&xt, &mut gt)
+                } else {
+                    f64::NAN
+                };
+                let rho = if ft.is_finite() && o.pred > 0.0 {
+                    (st.f - ft) / o.pred
+                } else if ft.is_finite() && o.pred <= 0.0 && ft < st.f {
+                    1.0
+                } else {
+                    f64::NEG_INFINITY
+                };
+                if rho < 0.25 {
+                    radius = 0.25 * o.znorm_m.min(radius);
+                } else if rho > 0.75 && o.boundary {
+                    radius *= 2.0;
+                }
+                if rho > 1e-4 && gt.iter().all(|v| v.is_finite()) {
+                    f_acc = ft;
+                    break;
+                }
+                let xs = norm(xr).max(1.0);
+                if radius <= 1e-15 * xs || o.znorm_m == 0.0 {
+                    break 'outer StopReason::TrustRadius;
+                }
+            }
+        } else {
+            let o = steihaug(&hv, g, &pre, f64::INFINITY, tol, opts.cg_max_iter, &mut w);
+            st.cg += o.iters;
+            let mut gd = dot(g, &w.z);
+            if gd.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) {
+                pre.apply(g, &mut w.z);
+                w.z.iter_mut().for_each(|v| *v = -*v);
+                gd = dot(g, &w.z);
+            }
+            let d = &w.z;
+            let smax = if guard {
+                0.95 * session.max_step(problem, xr, d)
+            } else {
+                f64::INFINITY
+            };
+            truncated = smax < 1.0;
+            let lsp = LineSearchParams {
+                stpmax: opts.line_search.stpmax.min(smax),
+                ..opts.line_search
+            };
+            let mut fe = 0;
+            let r = more_thuente(
+                |t| {
+                    fe += 1;
+                    add_scaled(xr, t, d, &mut xt);
+                    if guard && !session.admissible(problem, &xt) {
+                        return None;
+                    }
+                    let f = problem.value_grad(&xt, &mut gt);
+                    Some((f, dot(&gt, d)))
+                },
+                st.f,
+                gd,
+                1.0f64.min(lsp.stpmax),
+                &lsp,
+            );
+            st.fevals += fe;
+            if r.stp == 0.0 {
+                break 'outer StopReason::LineSearch(
+                    r.warning.unwrap_or(LineSearchFailure::Rounding),
+                );
+            }
+            f_acc = r.f;
+        }
+        x.copy_from_slice(&xt);
+        g.copy_from_slice(&gt);
+        let gn = norm(g);
+        if let Some(r) = st.accept(problem, x, f_acc, gn, opts, session, truncated) {
+            break r;
+        }
+    };
+    if assembled {
+        session.hess = Some(h);
+    }
+    reason
+}
+
+fn lbfgs<P: Problem + ?Sized>(
+    problem: &P,
+    x: &mut [f64],
+    g: &mut [f64],
+    opts: &SolverOptions,
+    session: &mut Session<'_>,
+    st: &mut State,
+) -> StopReason {
+    let n = x.len();
+    let m = opts.lbfgs_memory;
+    let mut s_hist: Vec<Vec<f64>> = Vec::with_capacity(m);
+    let mut y_hist: Vec<Vec<f64>> = Vec::with_capacity(m);
+    let mut rho: Vec<f64> = Vec::with_capacity(m);
+    let mut alpha = vec![0.0; m];
+    let mut d = vec![0.0; n];
+    let mut xt = vec![0.0; n];
+    let mut gt = vec![0.0; n];
+    let mut head = 0usize; // index of the oldest pair when full
+    loop {
+        // two-loop recursion
+        d.iter_mut().zip(g.iter()).for_each(|(d, g)| *d = -g);
+        let k = s_hist.len();
+        let order: Vec<usize> = (0..k).map(|i| (head + i) % k.max(1)).collect();
+        for &i in order.iter().rev() {
+            let a = rho[i] * dot(&s_hist[i], &d);
+            alpha[i] = a;
+            axpy(-a, &y_hist[i], &mut d);
+        }
+        let stp0 = if k > 0 {
+            let newest = *order.last().unwrap_or(&0);
+            let gamma =
+                dot(&s_hist[newest], &y_hist[newest]) / dot(&y_hist[newest], &y_hist[newest]);
+            d.iter_mut().for_each(|v| *v *= gamma);
+            1.0
+        } else {
+            1.0 / st.gnorm
+        };
+        for &i in &order {
+            let b = rho[i] * dot(&y_hist[i], &d);
+            axpy(alpha[i] - b, &s_hist[i], &mut d);
+        }
+        let mut gd = dot(g, &d);
+        if gd.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) {
+            d.iter_mut()
+                .zip(g.iter())
+                .for_each(|(d, g)| *d = -g / st.gnorm);
+            gd = dot(g, &d);
+            s_hist.clear();
+            y_hist.clear();
+            rho.clear();
+            head = 0;
+        }
+        let guard = session.guard_active(st.cur_min);
+        let xr: &[f64] = x;
+        let smax = if guard {
+            0.95 * session.max_step(problem, xr, &d)
+        } else {
+            f64::INFINITY
+        };
+        let truncated = smax < stp0;
+        let lsp = LineSearchParams {
+            stpmax: opts.line_search.stpmax.min(smax),
+            ..opts.line_search
+        };
+        let mut fe = 0;
+        let r = more_thuente(
+            |t| {
+                fe += 1;
+                add_scaled(xr, t, &d, &mut xt);
+                if guard && !session.admissible(problem, &xt) {
+                    return None;
+                }
+                let f = problem.value_grad(&xt, &mut gt);
+                Some((f, dot(&gt, &d)))
+            },
+            st.f,
+            gd,
+            stp0.min(lsp.stpmax),
+            &lsp,
+        );
+        st.fevals += fe;
+        if r.stp == 0.0 {
+            return StopReason::LineSearch(r.warning.unwrap_or(LineSearchFailure::Rounding));
+        }
+        // new pair
+        let mut s = vec![0.0; n];
+        add_scaled(&xt, -1.0, x, &mut s);
+        let mut y = vec![0.0; n];
+        add_scaled(&gt, -1.0, g, &mut y);
+        let sy = dot(&s, &y);
+        if sy > 1e-12 * norm(&s) * norm(&y) {
+            if s_hist.len() < m {
+                s_hist.push(s);
+                y_hist.push(y);
+                rho.push(1.0 / sy);
+            } else {
+                s_hist[head] = s;
+                y_hist[head] = y;
+                rho[head] = 1.0 / sy;
+                head = (head + 1) % m;
+            }
+        }
+        x.copy_from_slice(&xt);
+        g.copy_from_slice(&gt);
+        let gn = norm(g);
+        if let Some(reason) = st.accept(problem, x, r.f, gn, opts, session, truncated) {
+            return reason;
+        }
+    }
+}
+
+/// Greedy node colouring of the free-node adjacency (nodes sharing a cell get different
+/// colours), from the Hessian pattern.
+fn node_colors(h: &Csr, dim: usize) -> Vec<Vec<usize>> {
+    let nb = h.nrows / dim;
+    let mut color = vec![usize::MAX; nb];
+    let mut classes: Vec<Vec<usize>> = Vec::new();
+    let mut used: Vec<bool> = Vec::new();
+    for v in 0..nb {
+        used.iter_mut().for_each(|u| *u = false);
+        let r = v * dim;
+        for k in h.row_offsets[r]..h.row_offsets[r + 1] {
+            let u = h.col_indices[k] as usize / dim;
+            if color[u] != usize::MAX {
+                used[color[u]] = true;
+            }
+        }
+        let c = used.iter().position(|u| !u).unwrap_or(used.len());
+        if c == classes.len() {
+            classes.push(Vec::new());
+            used.push(false);
+        }
+        color[v] = c;
+        classes[c].push(v);
+    }
+    classes
+}
+
+/// Local Newton step of one node (`comp = None`: simultaneous; `Some(c)`: coordinate `c`).
+fn local_step(m: &unamalla_functionals::LocalModel, comp: Option<usize>) -> [f64; 3] {
+    let dim = m.dim;
+    let mut d = [0.0; 3];
+    if let Some(c) = comp {
+        let hcc = m.hess[c][c];
+        d[c] = if hcc > 0.0 {
+            -m.grad[c] / hcc
+        } else {
+            let s = (0..dim)
+                .map(|i| m.hess[i][i].abs())
+                .fold(0.0, f64::max)
+                .max(f64::MIN_POSITIVE);
+            -m.grad[c] / s
+        };
+        return d;
+    }
+    let ok = if dim == 2 {
+        let (p, q, r) = (
+            m.hess[0][0],
+            0.5 * (m.hess[0][1] + m.hess[1][0]),
+            m.hess[1][1],
+        );
+        let det = p * r - q * q;
+        if p > 0.0 && det > 1e-14 * p * r {
+            d[0] = -(r * m.grad[0] - q * m.grad[1]) / det;
+            d[1] = -(-q * m.grad[0] + p * m.grad[1]) / det;
+            true
+        } else {
+            false
+        }
+    } else if let Some(inv) = inv3_spd(&m.hess) {
+        for a in 0..3 {
+            d[a] = -(0..3).map(|b| inv[a][b] * m.grad[b]).sum::<f64>();
+        }
+        true
+    } else {
+        false
+    };
+    if !ok {
+        // indefinite local Hessian: gradient step scaled by the largest diagonal entry
+        let s = (0..dim)
+            .map(|i| m.hess[i][i].abs())
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+        for (da, ga) in d.iter_mut().zip(&m.grad).take(dim) {
+            *da = -ga / s;
+        }
+    }
+    d
+}
+
+fn pointwise<P: Problem + ?Sized>(
+    problem: &P,
+    x: &mut [f64],
+    g: &mut [f64],
+    opts: &SolverOptions,
+    session: &mut Session<'_>,
+    st: &mut State,
+    local_guard: Option<&QuadLocalGuard>,
+) -> StopReason {
+    let dim = problem.dim();
+    let ok = matches!(&session.colors, Some(c) if c.iter().map(Vec::len).sum::<usize>() * dim == problem.num_vars());
+    if !ok {
+        ensure_hessian(problem, session);
+        let h = session.hess.as_ref().expect("pattern built above");
+        session.colors = Some(node_colors(h, dim));
+    }
+    let colors = session.colors.take().unwrap_or_default();
+    let free = problem.free_nodes().to_vec();
+    let mut x0 = vec![0.0; x.len()];
+    let comps: Vec<Option<usize>> = match opts.pointwise_mode {
+        PointwiseMode::Simultaneous => vec![None],
+        PointwiseMode::Components => (0..dim).map(Some).collect(),
+    };
+    struct Prop {
+        v: usize,
+        d: [f64; 3],
+        old: [f64; 3],
+        val: f64,
+        gd: f64,
+        t: f64,
+        done: bool,
+    }
+    let thr = session.guard_threshold;
+    let reason = loop {
+        let guard = session.guard_active(st.cur_min);
+        x0.copy_from_slice(x);
+        for class in &colors {
+            for &comp in &comps {
+                let xr: &[f64] = x;
+                let mut props: Vec<Prop> = class
+                    .par_iter()
+                    .with_min_len(256)
+                    .filter_map(|&v| {
+                        let m = problem.local(xr, free[v])?;
+                        let d = local_step(&m, comp);
+                        let gd: f64 = (0..dim).map(|a| m.grad[a] * d[a]).sum();
+                        if gd.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) || !gd.is_finite()
+                        {
+                            return None;
+                        }
+                        let mut old = [0.0; 3];
+                        old[..dim].copy_from_slice(&xr[dim * v..dim * v + dim]);
+                        Some(Prop {
+                            v,
+                            d,
+                            old,
+                            val: m.value,
+                            gd,
+                            t: 1.0,
+                            done: false,
+                        })
+                    })
+                    .collect();
+                for _ in 0..8 {
+                    for p in props.iter().filter(|p| !p.done) {
+                        for a in 0..dim {
+                            x[dim * p.v + a] = p.old[a] + p.t * p.d[a];
+                        }
+                    }
+                    let xr: &[f64] = x;
+                    props
+                        .par_iter_mut()
+                        .with_min_len(256)
+                        .filter(|p| !p.done)
+                        .for_each(|p| {
+                            let node = free[p.v];
+                            let acc = problem.local(xr, node).is_some_and(|m| {
+                                m.value.is_finite() && m.value <= p.val + 1e-4 * p.t * p.gd
+                            }) && (!guard
+                                || local_guard.is_none_or(|lg| lg.node_min_alpha(xr, node) > thr));
+                            if acc {
+                                p.done = true;
+                            } else {
+                                p.t *= 0.5;
+                            }
+                        });
+                    if props.iter().all(|p| p.done) {
+                        break;
+                    }
+                }
+                for p in props.iter().filter(|p| !p.done) {
+                    x[dim * p.v..dim * p.v + dim].copy_from_slice(&p.old[..dim]);
+                }
+            }
+        }
+        if guard && local_guard.is_none() && !session.admissible(problem, x) {
+            // sweep-level safeguard: backtrack along the sweep displacement
+            let xs = x.to_vec();
+            let mut t = 0.5;
+            let mut found = false;
+            for _ in 0..40 {
+                for i in 0..x.len() {
+                    x[i] = x0[i] + t * (xs[i] - x0[i]);
+                }
+                if session.admissible(problem, x) {
+                    found = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+            if !found {
+                x.copy_from_slice(&x0);
+                break StopReason::LineSearch(LineSearchFailure::Rounding);
+            }
+        }
+        let f_new = problem.value_grad(x, g);
+        st.fevals += 1;
+        let gn = norm(g);
+        if let Some(r) = st.accept(problem, x, f_new, gn, opts, session, false) {
+            break r;
+        }
+    };
+    session.colors = Some(colors);
+    reason
+}

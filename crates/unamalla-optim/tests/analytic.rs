@@ -1,0 +1,307 @@
+//! Solvers on analytic problems with known minimizers (before any mesh).
+
+use unamalla_functionals::{Csr, LocalModel, Problem};
+use unamalla_optim::monitor::{Control, Monitor, NullObserver, Session};
+use unamalla_optim::solver::{minimize, PointwiseMode, Solver, SolverOptions};
+use unamalla_optim::status::StopReason;
+
+/// `F = ½ xᵀAx − bᵀx`, `A` = 2D "nodes on a chain" SPD matrix: node blocks `[[4, 1], [1, 3]]`
+/// on the diagonal and `−I` between neighbouring nodes. `b = A x*` with a chosen `x*`.
+struct Quadratic {
+    nodes: usize,
+    b: Vec<f64>,
+    free: Vec<usize>,
+}
+
+impl Quadratic {
+    fn new(nodes: usize, xstar: &[f64]) -> Self {
+        let mut q = Self {
+            nodes,
+            b: vec![0.0; 2 * nodes],
+            free: (0..nodes).collect(),
+        };
+        let mut b = vec![0.0; 2 * nodes];
+        q.apply(xstar, &mut b);
+        q.b = b;
+        q
+    }
+    fn apply(&self, v: &[f64], out: &mut [f64]) {
+        for i in 0..self.nodes {
+            let (x, y) = (v[2 * i], v[2 * i + 1]);
+            let mut ox = 4.0 * x + y;
+            let mut oy = x + 3.0 * y;
+            for j in [i.wrapping_sub(1), i + 1] {
+                if j < self.nodes {
+                    ox -= v[2 * j];
+                    oy -= v[2 * j + 1];
+                }
+            }
+            out[2 * i] = ox;
+            out[2 * i + 1] = oy;
+        }
+    }
+}
+
+impl Problem for Quadratic {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_vars(&self) -> usize {
+        2 * self.nodes
+    }
+    fn free_nodes(&self) -> &[usize] {
+        &self.free
+    }
+    fn var_of(&self, node: usize) -> Option<usize> {
+        (node < self.nodes).then_some(node)
+    }
+    fn value(&self, x: &[f64]) -> f64 {
+        let mut ax = vec![0.0; x.len()];
+        self.apply(x, &mut ax);
+        (0..x.len())
+            .map(|i| 0.5 * x[i] * ax[i] - self.b[i] * x[i])
+            .sum()
+    }
+    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
+        self.apply(x, g);
+        for (gi, bi) in g.iter_mut().zip(&self.b) {
+            *gi -= bi;
+        }
+        self.value(x)
+    }
+    fn hessian_pattern(&self) -> Csr {
+        let n = 2 * self.nodes;
+        let mut ro = vec![0];
+        let mut ci = Vec::new();
+        for r in 0..n {
+            let node = r / 2;
+            for nb in [node.wrapping_sub(1), node, node + 1] {
+                if nb < self.nodes {
+                    ci.push((2 * nb) as u32);
+                    ci.push((2 * nb + 1) as u32);
+                }
+            }
+            ro.push(ci.len());
+        }
+        Csr {
+            nrows: n,
+            ncols: n,
+            row_offsets: ro,
+            values: vec![0.0; ci.len()],
+            col_indices: ci,
+        }
+    }
+    fn hessian(&self, _x: &[f64], h: &mut Csr) {
+        for r in 0..h.nrows {
+            for k in h.row_offsets[r]..h.row_offsets[r + 1] {
+                let c = h.col_indices[k] as usize;
+                h.values[k] = if r / 2 == c / 2 {
+                    [[4.0, 1.0], [1.0, 3.0]][r % 2][c % 2]
+                } else if r % 2 == c % 2 {
+                    -1.0
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+    fn hess_vec(&self, _x: &[f64], v: &[f64], out: &mut [f64]) {
+        self.apply(v, out)
+    }
+    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
+        if node >= self.nodes {
+            return None;
+        }
+        let mut g = vec![0.0; x.len()];
+        let value = self.value_grad(x, &mut g);
+        Some(LocalModel {
+            value,
+            grad: [g[2 * node], g[2 * node + 1], 0.0],
+            hess: [[4.0, 1.0, 0.0], [1.0, 3.0, 0.0], [0.0; 3]],
+            dim: 2,
+        })
+    }
+    fn num_elements(&self) -> usize {
+        0
+    }
+    fn element_measures(&self, _x: &[f64], _out: &mut [f64]) {}
+}
+
+/// Rosenbrock `(1 − x)² + 100(y − x²)²` as a one-node 2D problem; minimizer (1, 1).
+struct Rosenbrock;
+
+impl Rosenbrock {
+    fn gh(x: &[f64]) -> (f64, [f64; 2], [[f64; 2]; 2]) {
+        let (a, b) = (x[0], x[1]);
+        let f = (1.0 - a).powi(2) + 100.0 * (b - a * a).powi(2);
+        let g = [
+            -2.0 * (1.0 - a) - 400.0 * a * (b - a * a),
+            200.0 * (b - a * a),
+        ];
+        let h = [
+            [2.0 - 400.0 * b + 1200.0 * a * a, -400.0 * a],
+            [-400.0 * a, 200.0],
+        ];
+        (f, g, h)
+    }
+}
+
+impl Problem for Rosenbrock {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_vars(&self) -> usize {
+        2
+    }
+    fn free_nodes(&self) -> &[usize] {
+        &[0]
+    }
+    fn var_of(&self, node: usize) -> Option<usize> {
+        (node == 0).then_some(0)
+    }
+    fn value(&self, x: &[f64]) -> f64 {
+        Self::gh(x).0
+    }
+    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
+        let (f, gg, _) = Self::gh(x);
+        g.copy_from_slice(&gg);
+        f
+    }
+    fn hessian_pattern(&self) -> Csr {
+        Csr {
+            nrows: 2,
+            ncols: 2,
+            row_offsets: vec![0, 2, 4],
+            col_indices: vec![0, 1, 0, 1],
+            values: vec![0.0; 4],
+        }
+    }
+    fn hessian(&self, x: &[f64], h: &mut Csr) {
+        let (_, _, hh) = Self::gh(x);
+        h.values
+            .copy_from_slice(&[hh[0][0], hh[0][1], hh[1][0], hh[1][1]]);
+    }
+    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+        let (_, _, h) = Self::gh(x);
+        out[0] = h[0][0] * v[0] + h[0][1] * v[1];
+        out[1] = h[1][0] * v[0] + h[1][1] * v[1];
+    }
+    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
+        (node == 0).then(|| {
+            let (f, g, h) = Self::gh(x);
+            LocalModel {
+                value: f,
+                grad: [g[0], g[1], 0.0],
+                hess: [[h[0][0], h[0][1], 0.0], [h[1][0], h[1][1], 0.0], [0.0; 3]],
+                dim: 2,
+            }
+        })
+    }
+    fn num_elements(&self) -> usize {
+        0
+    }
+    fn element_measures(&self, _x: &[f64], _out: &mut [f64]) {}
+}
+
+fn all_variants() -> Vec<SolverOptions> {
+    let mut v = Vec::new();
+    for s in Solver::ALL {
+        v.push(SolverOptions {
+            max_iter: 5000,
+            gtol: 1e-10,
+            ftol: 0.0,
+            ..SolverOptions::new(s)
+        });
+    }
+    for m in [3, 5, 1] {
+        v.push(SolverOptions {
+            lbfgs_memory: m,
+            max_iter: 5000,
+            gtol: 1e-10,
+            ftol: 0.0,
+            ..SolverOptions::new(Solver::Lbfgs)
+        });
+    }
+    v.push(SolverOptions {
+        pointwise_mode: PointwiseMode::Components,
+        max_iter: 20000,
+        gtol: 1e-10,
+        ftol: 0.0,
+        ..SolverOptions::new(Solver::Pointwise)
+    });
+    v
+}
+
+#[test]
+fn every_solver_finds_the_minimizer_of_a_convex_quadratic() {
+    let nodes = 40;
+    let xstar: Vec<f64> = (0..2 * nodes)
+        .map(|i| ((i * 7919) % 13) as f64 / 3.0 - 2.0)
+        .collect();
+    let q = Quadratic::new(nodes, &xstar);
+    for opts in all_variants() {
+        let mut x = vec![0.0; 2 * nodes];
+        let mut obs = NullObserver;
+        let mut s = Session::new(&q, &x, &mut obs);
+        let r = minimize(&q, &mut x, &opts, &mut s).unwrap();
+        let err = x
+            .iter()
+            .zip(&xstar)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            err < 1e-6,
+            "{:?} {:?}: error {err}, {r:?}",
+            opts.solver,
+            opts.pointwise_mode
+        );
+    }
+}
+
+#[test]
+fn every_solver_finds_the_minimizer_of_rosenbrock() {
+    for opts in all_variants() {
+        let mut x = vec![-1.2, 1.0];
+        let mut obs = NullObserver;
+        let mut s = Session::new(&Rosenbrock, &x, &mut obs);
+        let r = minimize(&Rosenbrock, &mut x, &opts, &mut s).unwrap();
+        assert!(
+            (x[0] - 1.0).abs() < 1e-5 && (x[1] - 1.0).abs() < 1e-5,
+            "{:?} {:?}: {x:?} {r:?}",
+            opts.solver,
+            opts.pointwise_mode
+        );
+    }
+}
+
+#[test]
+fn observer_can_stop_the_run() {
+    let mut x = vec![-1.2, 1.0];
+    let mut calls = 0;
+    let mut obs = |_: &Monitor| {
+        calls += 1;
+        if calls >= 3 {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    };
+    let mut s = Session::new(&Rosenbrock, &x, &mut obs);
+    let r = minimize(
+        &Rosenbrock,
+        &mut x,
+        &SolverOptions::new(Solver::Lbfgs),
+        &mut s,
+    )
+    .unwrap();
+    assert_eq!(r.reason, StopReason::User);
+    assert_eq!(r.iterations, 3);
+}
+
+#[test]
+fn nan_start_is_an_error_not_a_panic() {
+    let mut x = vec![f64::NAN, 1.0];
+    let mut obs = NullObserver;
+    let mut s = Session::new(&Rosenbrock, &[0.0, 0.0], &mut obs);
+    assert!(minimize(&Rosenbrock, &mut x, &SolverOptions::default(), &mut s).is_err());
+}
