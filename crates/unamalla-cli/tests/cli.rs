@@ -269,3 +269,33 @@ fn mesh_of_a_bad_region_writes_nothing() {
     );
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn eval_raw_length_on_a_hand_written_grid() {
+    // 3 × 3 nodes on the unit grid [0,2]²: four unit-square cells, each with four corner
+    // triangles of l = 1 + 1 = 2, so the raw length is 4 · 4 · 2 = 32; the centre node is the
+    // only free node and by symmetry the gradient there vanishes.
+    let dir = tmpdir("eval");
+    let f = dir.join("g.vtk");
+    std::fs::write(
+        &f,
+        "# vtk DataFile Version 3.0\ngrid\nASCII\nDATASET STRUCTURED_GRID\nDIMENSIONS 3 3 1\nPOINTS 9 double\n\
+         0 0 0 1 0 0 2 0 0\n0 1 0 1 1 0 2 1 0\n0 2 0 1 2 0 2 2 0\n",
+    )
+    .unwrap();
+    let st = bin()
+        .arg("eval")
+        .arg(&f)
+        .args(["--functional", "length", "--raw"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    assert!((v["value"].as_f64().unwrap() - 32.0).abs() < 1e-12, "{v}");
+    assert!(v["gradient_norm"].as_f64().unwrap().abs() < 1e-12, "{v}");
+    std::fs::remove_dir_all(dir).ok();
+}
