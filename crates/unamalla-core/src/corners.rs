@@ -1,106 +1,28 @@
 //! Automatic corner choice for a roughly four-sided ring (seed 000 digest §4.2, thesis §5.1.1).
 //!
-//! The thesis's heuristic: four vertices that are neither (nearly) collinear points nor reflex
-//! vertices, such that opposite sides have approximately equal length. We make it a small
-//! optimization over candidate vertices (convex vertices with a left angle below
-//! [`MAX_CORNER_ANGLE_DEG`]), minimizing
-//!
-//! ```text
-//! score = Σ_pairs |L₁ − L₂| / (L₁ + L₂)            (balanced opposite sides)
-//!       + ½ · Σ_corners |θ − 90°| / 90°             (corners close to right angles)
-//!       + Σ_sides (1 − chord / arc length)          (sides that are not folded back on themselves)
-//! ```
-//!
-//! where the first term compares bottom/top and right/left arc lengths. If more than
-//! [`MAX_CANDIDATES`] vertices qualify, the sharpest ones (smallest angles) are kept, which is
-//! where a person would put corners. The search is exhaustive over the candidates (O(c⁴) with
-//! c ≤ 40, well under a second).
+//! The choice itself is the decomposition stage's corner selection
+//! ([`unamalla_decompose::select_corners`]: four non-reflex, non-flat vertices with balanced
+//! opposite sides — one implementation for blocks and for single-block TFI). This module only
+//! adds the orientation: which pair of opposite sides becomes bottom/top, so that the grid's
+//! aspect `(M−1)/(N−1)` matches the region's.
 
+use unamalla_decompose::{select_corners, CornerWeights};
 use unamalla_mesh::Polygon;
 
 use crate::CoreError;
-
-/// Vertices with a region-side angle above this (degrees) are never corners.
-pub const MAX_CORNER_ANGLE_DEG: f64 = 165.0;
-/// At most this many candidate vertices enter the exhaustive search.
-pub const MAX_CANDIDATES: usize = 40;
-
-/// The score of a corner quadruple (lower is better); see the module documentation.
-pub fn corner_score(poly: &Polygon, corners: [usize; 4]) -> f64 {
-    let pts = poly.points();
-    let n = pts.len();
-    let mut arc = [0.0; 4];
-    let mut chord = [0.0; 4];
-    for s in 0..4 {
-        let (a, b) = (corners[s], corners[(s + 1) % 4]);
-        let mut k = a;
-        while k != b {
-            let k2 = (k + 1) % n;
-            arc[s] += pts[k].distance(pts[k2]);
-            k = k2;
-        }
-        chord[s] = pts[a].distance(pts[b]);
-    }
-    let balance = |x: f64, y: f64| {
-        if x + y > 0.0 {
-            (x - y).abs() / (x + y)
-        } else {
-            1.0
-        }
-    };
-    let mut score = balance(arc[0], arc[2]) + balance(arc[1], arc[3]);
-    for &c in &corners {
-        score += 0.5 * (poly.left_angle(c).to_degrees() - 90.0).abs() / 90.0;
-    }
-    for s in 0..4 {
-        if arc[s] > 0.0 {
-            score += 1.0 - chord[s] / arc[s];
-        }
-    }
-    score
-}
 
 /// Chooses four corners of `poly` (indices into its points, counter-clockwise order). When
 /// `aspect` (the wanted ratio bottom-side length / left-side length, e.g. `(M−1)/(N−1)` for an
 /// `M × N` grid) is given, the quadruple is rotated so that the bottom/top pair best matches it.
 ///
-/// Errors: fewer than four admissible (convex, non-flat) vertices.
+/// Errors: no admissible quadruple (e.g. fewer than four convex, non-flat vertices).
 pub fn auto_corners(poly: &Polygon, aspect: Option<f64>) -> Result<[usize; 4], CoreError> {
     let n = poly.len();
-    let mut cand: Vec<(usize, f64)> = (0..n)
-        .map(|i| (i, poly.left_angle(i).to_degrees()))
-        .filter(|&(_, a)| a < MAX_CORNER_ANGLE_DEG)
-        .collect();
-    if cand.len() < 4 {
-        return Err(CoreError::Corners(format!(
-            "only {} vertices with an angle below {MAX_CORNER_ANGLE_DEG}°; four corners are needed",
-            cand.len()
-        )));
-    }
-    if cand.len() > MAX_CANDIDATES {
-        cand.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
-        cand.truncate(MAX_CANDIDATES);
-    }
-    let mut idx: Vec<usize> = cand.iter().map(|c| c.0).collect();
-    idx.sort_unstable();
-    let c = idx.len();
-    let mut best: Option<(f64, [usize; 4])> = None;
-    for a in 0..c {
-        for b in a + 1..c {
-            for d in b + 1..c {
-                for e in d + 1..c {
-                    let q = [idx[a], idx[b], idx[d], idx[e]];
-                    let s = corner_score(poly, q);
-                    if best.is_none_or(|(bs, _)| s < bs) {
-                        best = Some((s, q));
-                    }
-                }
-            }
-        }
-    }
-    let Some((_, mut q)) = best else {
-        return Err(CoreError::Corners("no corner quadruple found".into()));
-    };
+    let (mut q, _) = select_corners(poly.points(), &CornerWeights::default()).ok_or_else(|| {
+        CoreError::Corners(format!(
+            "no four admissible corners (convex, not flat, balanced sides) among the {n} vertices"
+        ))
+    })?;
     if let Some(aspect) = aspect.filter(|a| a.is_finite() && *a > 0.0) {
         let pts = poly.points();
         let arc = |a: usize, b: usize| {
