@@ -1,4 +1,4 @@
-//! Prints the markdown tables of `docs/results-contour.md`: every method at its default
+//! Prints the markdown tables of `docs/results.md (section "Results: unamalla-contour")`: every method at its default
 //! (clean-preset) thresholds on every region of `fixtures/regions/*.geojson`, plus `geo`'s
 //! Visvalingam–Whyatt (`SimplifyVw`, `SimplifyVwPreserve`) at the area threshold that gives
 //! the closest point count not above the modified-areas result.

@@ -1,5 +1,5 @@
 //! Decomposes every region in `fixtures/regions/*.geojson` automatically and prints the
-//! results table of `docs/results-decompose.md`; with `--svg DIR` also writes
+//! results table of `docs/results.md (section "Decomposition results")`; with `--svg DIR` also writes
 //! `DIR/decomposition-<name>.svg` and `DIR/decomposition-<name>.json`.
 //!
 //! ```text

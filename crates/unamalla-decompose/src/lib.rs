@@ -107,7 +107,7 @@
 //! three-vertex block bounded by cuts alone gets a cut split in two (both neighbours get the vertex);
 //! such a joint is the only place where a cut endpoint may lie off the region boundary, and it
 //! is an interior mesh node of valence 3 (a singularity) — it does not occur in the fixture
-//! decompositions of `docs/results-decompose.md` unless the table says so.
+//! decompositions of `docs/results.md (section "Decomposition results")` unless the table says so.
 //!
 //! **Corners** ([`corners`], seed 000 digest §4.2): the best 4-tuple of non-reflex,
 //! non-collinear vertices by `F = ¼Σg(θ) + w_bal·balance + w_turn·straightness`; triangles get
