@@ -49,15 +49,9 @@ use crate::kernels2::phi_omega;
 use crate::problem::{LocalModel, Problem};
 
 /// The six faces of a hexahedron (0-based VTK indices) in the seed 004 order
-/// (1234), (5678), (1265), (4378), (1485), (2376).
-pub const HEX_QUAD_FACES: [[usize; 4]; 6] = [
-    [0, 1, 2, 3],
-    [4, 5, 6, 7],
-    [0, 1, 5, 4],
-    [3, 2, 6, 7],
-    [0, 3, 7, 4],
-    [1, 2, 6, 5],
-];
+/// (1234), (5678), (1265), (4378), (1485), (2376) — the same table the quality module's
+/// planarity test uses ([`unamalla_mesh::quality::hex::PLANARITY_FACES`]).
+pub const HEX_QUAD_FACES: [[usize; 4]; 6] = unamalla_mesh::quality::hex::PLANARITY_FACES;
 
 /// One tetrahedron of the hex split: Jacobian column `a` is `Σⱼ stencil[a][j]·X[nodes[j]]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
