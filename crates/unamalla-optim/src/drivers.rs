@@ -215,6 +215,40 @@ struct Init {
     inocon: usize,
 }
 
+/// Common start of the 2D drivers: a `Length` probe functional on `topo` and the convexity of
+/// the start `x`; errors if the boundary does not enclose a positive mean α (ᾱ).
+fn quad_start(
+    topo: &Arc<QuadTopology>,
+    x: &[f64],
+    session: &mut Session<'_>,
+) -> Result<(QuadFunctional<Kernel2>, crate::monitor::Convexity), OptimError> {
+    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let c0 = session.convexity(&probe, x);
+    let ab = c0.mean;
+    if !(ab > 0.0 && ab.is_finite()) {
+        return Err(OptimError::InvalidOption {
+            name: "mean alpha",
+            value: ab,
+            reason: "the boundary must enclose a positive area (counter-clockwise)",
+        });
+    }
+    Ok((probe, c0))
+}
+
+/// The initial record of a run: the start's α₋ and Inocon, and the first status message.
+fn start_record(c0: &crate::monitor::Convexity) -> (Init, Vec<Status>) {
+    let init = Init {
+        min: c0.min,
+        inocon: c0.nonconvex_cells,
+    };
+    let first = if c0.convex() {
+        Status::InitialConvex
+    } else {
+        Status::InitialNonConvex
+    };
+    (init, vec![first])
+}
+
 fn report(
     session: &mut Session<'_>,
     problem: &dyn Problem,
@@ -327,25 +361,9 @@ pub fn adaptive_k(
     }
     let n = topo.num_triangles();
     let guard = QuadLocalGuard::new(topo.clone());
-    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
-    let c0 = session.convexity(&probe, x);
+    let (probe, c0) = quad_start(topo, x, session)?;
     let ab = c0.mean;
-    if !(ab > 0.0 && ab.is_finite()) {
-        return Err(OptimError::InvalidOption {
-            name: "mean alpha",
-            value: ab,
-            reason: "the boundary must enclose a positive area (counter-clockwise)",
-        });
-    }
-    let init = Init {
-        min: c0.min,
-        inocon: c0.nonconvex_cells,
-    };
-    let mut messages = vec![if c0.convex() {
-        Status::InitialConvex
-    } else {
-        Status::InitialNonConvex
-    }];
+    let (init, mut messages) = start_record(&c0);
     let w_final = match opts.functional {
         KFunctional::KSmoothArea | KFunctional::KAreaLength => 1.0 - opts.sigma,
         _ => 0.0,
@@ -464,16 +482,8 @@ pub fn omega_continuation(
     }
     let n = topo.num_triangles();
     let guard = QuadLocalGuard::new(topo.clone());
-    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
-    let c0 = session.convexity(&probe, x);
+    let (probe, c0) = quad_start(topo, x, session)?;
     let ab = c0.mean;
-    if !(ab > 0.0 && ab.is_finite()) {
-        return Err(OptimError::InvalidOption {
-            name: "mean alpha",
-            value: ab,
-            reason: "the boundary must enclose a positive area (counter-clockwise)",
-        });
-    }
     let make = |w: f64| -> Result<QuadFunctional<Kernel2>, OptimError> {
         Ok(QuadFunctional::new(
             topo.clone(),
@@ -518,15 +528,7 @@ fn omega_loop<P: Problem>(
             reason: "ω₀ must be > 0",
         });
     }
-    let init = Init {
-        min: c0.min,
-        inocon: c0.nonconvex_cells,
-    };
-    let mut messages = vec![if c0.convex() {
-        Status::InitialConvex
-    } else {
-        Status::InitialNonConvex
-    }];
+    let (init, mut messages) = start_record(&c0);
     session.set_phase(Phase::Homotopic);
     session.guard_threshold = 0.0;
     let mut last;
@@ -623,16 +625,8 @@ pub fn coplanarity_continuation(
     }
     let probe = HexFunctional::h_omega(topo.clone(), 1.0, scaling)?;
     let c0 = session.convexity(&probe, x);
-    let init = Init {
-        min: c0.min,
-        inocon: c0.nonconvex_cells,
-    };
+    let (init, mut messages) = start_record(&c0);
     let omega = (opts.omega_rel * c0.mean).max(f64::MIN_POSITIVE);
-    let mut messages = vec![if c0.convex() {
-        Status::InitialConvex
-    } else {
-        Status::InitialNonConvex
-    }];
     session.set_phase(Phase::Homotopic);
     session.guard_threshold = 0.0;
     session.monitor.omega = Some(omega);
@@ -723,25 +717,9 @@ pub fn block_smoothing(
         return Err(OptimError::NoFreeNodes);
     }
     let n = topo.num_triangles();
-    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
-    let c0 = session.convexity(&probe, x);
+    let (probe, c0) = quad_start(topo, x, session)?;
     let ab = c0.mean;
-    if !(ab > 0.0 && ab.is_finite()) {
-        return Err(OptimError::InvalidOption {
-            name: "mean alpha",
-            value: ab,
-            reason: "the boundary must enclose a positive area (counter-clockwise)",
-        });
-    }
-    let init = Init {
-        min: c0.min,
-        inocon: c0.nonconvex_cells,
-    };
-    let mut messages = vec![if c0.convex() {
-        Status::InitialConvex
-    } else {
-        Status::InitialNonConvex
-    }];
+    let (init, mut messages) = start_record(&c0);
     if !c0.eps_convex(opts.eps) {
         let uo = AdaptiveKOptions {
             k_star: -opts.eps,
