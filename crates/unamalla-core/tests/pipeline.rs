@@ -57,8 +57,30 @@ fn check(result: &MeshResult, holes: usize) {
             );
         }
     }
-    // cut nodes are shared: block boundary nodes that are not on the region boundary map to
-    // global nodes used by cells of at least two blocks
+    // the two blocks of every cut share its nodes through their local→global maps (cut nodes
+    // move during smoothing, so this is checked topologically: the blocks share at least the
+    // cut's two endpoints; the real conformity check is the boundary-loop count above, where an
+    // unmatched cut would show up as an extra loop)
+    let mut owners: Vec<Vec<usize>> = vec![Vec::new(); mesh.num_nodes()];
+    for b in 0..result.mesh.blocks().len() {
+        for &g in result.mesh.block_node_map(b) {
+            if owners[g].last() != Some(&b) {
+                owners[g].push(b);
+            }
+        }
+    }
+    for cut in &result.decomposition.cuts {
+        let [b0, b1] = cut.blocks;
+        let shared = owners
+            .iter()
+            .filter(|o| o.contains(&b0) && o.contains(&b1))
+            .count();
+        assert!(
+            shared >= 2,
+            "cut {} between blocks {b0} and {b1} shares {shared} nodes",
+            cut.id
+        );
+    }
     assert_eq!(rep.cells, mesh.num_quads());
     assert_eq!(rep.blocks, result.decomposition.blocks.len());
 }

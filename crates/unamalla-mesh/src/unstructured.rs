@@ -209,15 +209,8 @@ fn check_cells<const K: usize>(num_nodes: usize, cells: &[[usize; K]]) -> Result
 
 /// Nodes on edges that belong to exactly one quad.
 fn quad_boundary_flags(num_nodes: usize, cells: &[[usize; 4]]) -> Vec<bool> {
-    let mut count: HashMap<(usize, usize), u32> = HashMap::with_capacity(cells.len() * 2);
-    for c in cells {
-        for k in 0..4 {
-            let (a, b) = (c[k], c[(k + 1) % 4]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
     let mut flags = vec![false; num_nodes];
-    for ((a, b), n) in count {
+    for ((a, b), n) in crate::quality::mesh::quad_edge_counts(cells.iter().copied(), cells.len()) {
         if n == 1 {
             flags[a] = true;
             flags[b] = true;

@@ -213,9 +213,20 @@ pub fn is_high_quality(mu: &[f64]) -> bool {
 /// The undirected edges of a quad mesh, `(min, max)` node ids, each with the number of cells
 /// using it; sorted (deterministic, no hashing).
 fn quad_edges<M: HasQuadCells + ?Sized>(mesh: &M) -> Vec<((usize, usize), u32)> {
-    let mut e: Vec<(usize, usize)> = Vec::with_capacity(4 * mesh.num_quads());
-    for c in 0..mesh.num_quads() {
-        let q = mesh.quad(c);
+    quad_edge_counts(
+        (0..mesh.num_quads()).map(|c| mesh.quad(c)),
+        mesh.num_quads(),
+    )
+}
+
+/// [`quad_edges`] over any list of quads (`len` is a capacity hint): the one edge census of the
+/// crate, also used by [`QuadMesh`](crate::QuadMesh) for its boundary flags.
+pub(crate) fn quad_edge_counts(
+    quads: impl Iterator<Item = [usize; 4]>,
+    len: usize,
+) -> Vec<((usize, usize), u32)> {
+    let mut e: Vec<(usize, usize)> = Vec::with_capacity(4 * len);
+    for q in quads {
         for k in 0..4 {
             let (a, b) = (q[k], q[(k + 1) % 4]);
             if a != b {
