@@ -3,7 +3,7 @@
 # table row per region (used for docs/results.md). Usage: scripts/mesh_all_regions.sh [timeout_s]
 set -u
 cd "$(dirname "$0")/.."
-t=${1:-120}
+t=${1:-150}
 cargo build --release -q -p unamalla-cli
 echo "| region | cells | blocks | non-convex | interior sing. | μ ≥ 0.8 % | min SJ | p5 SJ | α₋/ᾱ | area change % | Hausdorff | seconds |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|"

@@ -12,7 +12,7 @@ use unamalla_core::io::{self, PartSelector, VtkMesh};
 use unamalla_core::mesh::quality::quad_cell_metrics;
 use unamalla_core::mesh::{QuadMesh, Region};
 use unamalla_core::optim::{self, NullObserver, Observer, ProgressObserver, SmoothOptions};
-use unamalla_core::pipeline::Mesher;
+use unamalla_core::pipeline::{Mesher, Strategy};
 use unamalla_core::render;
 
 fn read_region(path: &Path) -> Result<Region> {
@@ -37,6 +37,7 @@ fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
 pub struct MeshArgs {
     pub region: PathBuf,
     pub decomposition: Option<PathBuf>,
+    pub strategy: String,
     pub cells: Option<usize>,
     pub density: Option<usize>,
     pub cell_size: Option<f64>,
@@ -65,6 +66,12 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
         bail!("--boundary-density must be a number ≥ 1");
     }
     mesher = mesher.boundary_density(a.boundary_density);
+    mesher = mesher.strategy(match a.strategy.as_str() {
+        "submap" => Strategy::Submap,
+        "auto" => Strategy::Auto,
+        "cuts" => Strategy::Cuts,
+        other => bail!("--strategy must be cuts, submap or auto, got {other}"),
+    });
     let mut sopts = SimplifyOptions::default();
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);

@@ -3,12 +3,21 @@
 //! Subcommands:
 //! * `unamalla tfi <region> --size MxN [--corners a,b,c,d | --auto-corners] -o out.vtk`
 //! * `unamalla quality <mesh.vtk> [--json]`
-//! * `unamalla mesh <region> [--decomposition file.json] [--cells N | --density d | --cell-size h]
-//!   [--boundary-density w] [--min-hole-area A] -o <outdir> [--json] [--quiet]`
+//! * `unamalla mesh <region> [--decomposition file.json] [--strategy cuts|submap|auto]
+//!   [--cells N | --density d | --cell-size h] [--boundary-density w] [--min-hole-area A]
+//!   -o <outdir> [--json] [--quiet]`
 //! * `unamalla eval <mesh> --functional NAME [--omega w] [--k k] [--raw] [--json]`
 //! * `unamalla smooth <mesh> [--functional NAME] [--solver tn-tr|tn-ls|lbfgs|pointwise] -o out`
 //! * `unamalla simplify <region> --method NAME [--epsilon e] [--delta d] -o out.geojson [--svg f]`
 //! * `unamalla decompose <region> [--from file.json] -o decomposition.json [--svg out.svg]`
+//! * `unamalla counts <problem.json> [--density d | --cell-size h] [-o counts.json]`
+//! * `unamalla bspline <region> [--degree 1|2] [--net NxM] [--blocks] [--samples K] -o <outdir>`
+//! * `unamalla hex <case|facedir> [--size m,n,p] [--perturb s | --nonconvex N] [--seed k]
+//!   [--algorithm a|b] -o <outdir> [--json] [--quiet]`
+//! * `unamalla pde <mesh> [--a .. --b .. --c .. --d ..] [--g const:V|sin:A]
+//!   [--bc 1=parabolic:P,2=const:V,3=sin:P,4=..|all=..] [--manufactured sin-cosh|poly]
+//!   [--solver sor|direct] [--omega w] -o <outdir> [--json]`
+//! * `unamalla refine <mesh> --factor k [--factor-i ki] [--factor-j kj] -o out.vtk`
 //!
 //! Errors are reported as one line on stderr with a non-zero exit code; output files are
 //! written atomically, so a failed run never leaves a partial file.
@@ -16,7 +25,12 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod bspline;
 mod commands;
+mod counts;
+mod hex;
+mod pde;
+mod refine;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
@@ -69,6 +83,11 @@ enum Command {
         /// together with --no-simplify) instead of the automatic one.
         #[arg(long)]
         decomposition: Option<PathBuf>,
+        /// Decomposition strategy: cuts (seed 000, default), submap (seed 002 submapping), or
+        /// auto (submap when every angle is within 10° of a multiple of 90° and no vertex
+        /// reclassification is needed, else cuts).
+        #[arg(long, default_value = "cuts", value_parser = ["cuts", "submap", "auto"])]
+        strategy: String,
         /// About this many cells (default 20000).
         #[arg(long, conflicts_with_all = ["density", "cell_size"])]
         cells: Option<usize>,
@@ -169,6 +188,19 @@ enum Command {
         #[arg(long)]
         svg: Option<PathBuf>,
     },
+    /// Compatible point counts of a compatibility problem (JSON), with pinned counts honoured.
+    Counts(counts::CountsArgs),
+    /// B-spline parametrization (bilinear or biquadratic) of a region from a convex control net,
+    /// with injectivity certificates and a dense det J sample (seed 003).
+    Bspline(bspline::BsplineArgs),
+    /// Structured hexahedral mesh of a built-in region or six face grids, made convex
+    /// (Algorithm A) with planar interior faces (Algorithm B) (seed 004).
+    Hex(hex::HexArgs),
+    /// Solve a·U_xx + 2b·U_xy + c·U_yy + d·U = g on a convex mesh (SOR or sparse LU); writes
+    /// VTK point data `u`, a Geomview MESH surface and PNG/SVG plots (seed 001 RF12).
+    Pde(pde::PdeArgs),
+    /// Uniform refinement of a convex structured grid: every cell into k × k (seed 001 RF11).
+    Refine(refine::RefineArgs),
     /// Quality report of a mesh file (VTK legacy: structured grid or quad/hex unstructured grid).
     Quality {
         /// Mesh file.
@@ -244,6 +276,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Mesh {
             region,
             decomposition,
+            strategy,
             cells,
             density,
             cell_size,
@@ -256,6 +289,7 @@ fn run(cli: Cli) -> Result<()> {
         } => commands::mesh(commands::MeshArgs {
             region,
             decomposition,
+            strategy,
             cells,
             density,
             cell_size,
@@ -295,6 +329,11 @@ fn run(cli: Cli) -> Result<()> {
             output,
             svg,
         } => commands::decompose(&region, from.as_deref(), &output, svg.as_deref())?,
+        Command::Counts(args) => counts::run(args)?,
+        Command::Bspline(args) => bspline::run(args)?,
+        Command::Hex(args) => hex::run(args)?,
+        Command::Pde(args) => pde::run(args)?,
+        Command::Refine(args) => refine::run(args)?,
         Command::Quality { mesh, json } => {
             let file = io::read_vtk(&mesh)?;
             let report = match &file.mesh {
@@ -317,12 +356,18 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            // One line: the context chain joined by ": ", skipping a cause whose text the
+            // message already contains (library errors such as `IoError::Geometry` print
+            // their source themselves), with any newline flattened.
             let mut msg = e.to_string();
             for cause in e.chain().skip(1) {
-                msg.push_str(": ");
-                msg.push_str(&cause.to_string());
+                let c = cause.to_string();
+                if !msg.contains(&c) {
+                    msg.push_str(": ");
+                    msg.push_str(&c);
+                }
             }
-            eprintln!("error: {msg}");
+            eprintln!("error: {}", msg.replace('\n', " "));
             ExitCode::FAILURE
         }
     }

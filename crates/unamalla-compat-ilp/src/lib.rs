@@ -86,6 +86,9 @@
 //! `id` used in messages and printed equations (`m{id}`). [`CompatProblem::from_index_sets`] builds the
 //! thesis numbering `J_{k,side}` (erratum 13: that convention is authoritative).
 #![warn(missing_docs)]
+// No unwrap/expect in library code: user input must give an error, never a panic (issue #14,
+// docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod error;
 pub mod fixtures;
@@ -108,4 +111,7 @@ pub use problem::{Block, CompatProblem, Curve, CutPair, LowerBounds, Side, MAX_C
 pub use solve::{solve, verify_counts, CompatSolution, Method, SolveOptions, SolverPath};
 pub use system::{block_sizes, BlockSize, CompatSystem, Equation, EquationKind};
 pub use verify::{Optimality, Verification};
-pub use vertex::{classify_vertices, VertexClassOptions, VertexClassification, VertexKind};
+pub use vertex::{
+    classify_vertices, classify_vertices_to_sum, VertexClassOptions, VertexClassification,
+    VertexKind,
+};

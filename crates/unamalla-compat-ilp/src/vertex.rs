@@ -108,6 +108,48 @@ pub fn classify_vertices(
     alpha_real: &[f64],
     options: &VertexClassOptions,
 ) -> Result<VertexClassification, CompatError> {
+    let target = 4i64 * (1 - options.holes as i64);
+    let program = if options.holes == 0 {
+        "vertex classification (6)"
+    } else {
+        "vertex classification (8)"
+    };
+    classify_impl(alpha_real, target, program, options)
+}
+
+/// The same program with an explicit right-hand side `Σ_i α_i = target` (`options.holes` is ignored).
+///
+/// This is the **per-loop** variant of (8) the seed 002 digest §8.4 \[NOTE\] offers next to the paper's
+/// global sum: the outer loop alone gets `target = 4` (program (6)) and each hole loop alone gets
+/// `target = −4` (its straight-edge turning sum with the domain on the left is `−2π`).
+///
+/// ```
+/// use unamalla_compat_ilp::{classify_vertices_to_sum, VertexClassOptions, VertexKind};
+/// // a square hole traversed clockwise: four turns of −π/2
+/// let c = classify_vertices_to_sum(&[-1.0; 4], -4, &VertexClassOptions::default())?;
+/// assert_eq!(c.kinds, vec![VertexKind::Corner; 4]);
+/// assert_eq!(c.cost, 0.0);
+/// # Ok::<(), unamalla_compat_ilp::CompatError>(())
+/// ```
+pub fn classify_vertices_to_sum(
+    alpha_real: &[f64],
+    target: i64,
+    options: &VertexClassOptions,
+) -> Result<VertexClassification, CompatError> {
+    classify_impl(
+        alpha_real,
+        target,
+        "vertex classification (per-loop sum)",
+        options,
+    )
+}
+
+fn classify_impl(
+    alpha_real: &[f64],
+    target: i64,
+    program: &'static str,
+    options: &VertexClassOptions,
+) -> Result<VertexClassification, CompatError> {
     let n = alpha_real.len();
     if n == 0 {
         return Err(CompatError::InvalidParameter("no vertices".into()));
@@ -132,7 +174,6 @@ pub fn classify_vertices(
     };
     let rho = weights(&options.rho, "ρ")?;
     let omega = weights(&options.omega, "ω")?;
-    let target = 4i64 * (1 - options.holes as i64);
     let ranges: Vec<(i64, i64)> = alpha_real.iter().map(|&a| admissible(a)).collect();
     if let Some(i) = ranges.iter().position(|&(lo, hi)| lo > hi) {
         return Err(CompatError::ProgramInfeasible {
@@ -145,11 +186,6 @@ pub fn classify_vertices(
     }
     let lo_sum: i64 = ranges.iter().map(|r| r.0).sum();
     let hi_sum: i64 = ranges.iter().map(|r| r.1).sum();
-    let program = if options.holes == 0 {
-        "vertex classification (6)"
-    } else {
-        "vertex classification (8)"
-    };
     if target < lo_sum || target > hi_sum {
         return Err(CompatError::ProgramInfeasible {
             program,

@@ -69,6 +69,9 @@
 //! dropped below an area threshold first ([`HoleFilter`]).
 
 #![warn(missing_docs)]
+// No unwrap/expect in library code: user input must give an error, never a panic (issue #14,
+// docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod criteria;
 mod error;
@@ -83,8 +86,8 @@ pub use mpp::{minimum_perimeter_polygon, MppOptions, MppResult};
 pub use noise::{detect_noise, detect_noise_region, log_area_profile, NoiseReport};
 pub use overlay::overlay_svg;
 pub use simplify::{
-    hausdorff, simplify_region, DroppedHole, HoleFilter, Method, Preset, RingReport,
-    SimplifyOptions, SimplifyResult,
+    hausdorff, remove_features_below, simplify_region, DroppedHole, HoleFilter, Method, Preset,
+    RingReport, SimplifyOptions, SimplifyResult,
 };
 
 /// Absolute shoelace area of an open ring.

@@ -141,6 +141,9 @@ pub fn detect_noise(ring: &[DVec2]) -> Result<NoiseReport, ContourError> {
 
 /// Runs the detector on every ring of a region (outer first, then holes). The region verdict
 /// is noisy if any ring with at least [`MIN_VERTICES`] vertices is.
+// `detect_noise` fails only for rings with fewer than 3 points or non-finite coordinates,
+// which `Region` validation has already rejected.
+#[allow(clippy::expect_used)]
 pub fn detect_noise_region(region: &unamalla_mesh::Region) -> (bool, Vec<NoiseReport>) {
     let reports: Vec<NoiseReport> = region
         .rings()

@@ -541,3 +541,34 @@ proptest! {
         prop_assert_eq!(res.region.holes().len(), region.holes().len());
     }
 }
+
+#[test]
+fn features_below_an_absolute_area_are_removed_and_larger_ones_kept() {
+    // Square [0,10]² with a thin spike (width 0.2, height 1) on its bottom side and a hole.
+    // ζ = α²/(l₁l₂) (eq. 3.4) of the spike apex (5,1): legs (−0.1,−1), (0.1,−1), α = 0.2,
+    // l₁l₂ = 1.01 → ζ ≈ 0.0396 < 0.1, removed; then the two spike feet are collinear with the
+    // side (ζ = 0), removed. The square corners have ζ = 10²·1 = 100 and the hole's corners
+    // (side 2) ζ = 4: all kept at the threshold 0.1.
+    let outer = vec![
+        v(0., 0.),
+        v(4.9, 0.),
+        v(5., 1.),
+        v(5.1, 0.),
+        v(10., 0.),
+        v(10., 10.),
+        v(0., 10.),
+    ];
+    let hole = vec![v(6., 6.), v(6., 8.), v(8., 8.), v(8., 6.)];
+    let r = Region::new(outer, vec![hole.clone()]).unwrap();
+    let out = unamalla_contour::remove_features_below(&r, 0.1).unwrap();
+    assert_eq!(out.outer().len(), 4);
+    assert!((out.outer().area() - 100.0).abs() < 1e-12);
+    assert_eq!(out.holes().len(), 1);
+    assert_eq!(out.holes()[0].len(), 4);
+    // below the apex's ζ nothing goes
+    let same = unamalla_contour::remove_features_below(&r, 0.03).unwrap();
+    assert_eq!(same.outer().len(), 7);
+    // a negative or NaN threshold is a typed error
+    assert!(unamalla_contour::remove_features_below(&r, f64::NAN).is_err());
+    assert!(unamalla_contour::remove_features_below(&r, -1.0).is_err());
+}

@@ -6,6 +6,11 @@
 //! * [`single_block`]: one structured grid on a roughly four-sided region by transfinite
 //!   interpolation (seed 000 digest §5.1) between four arc-length-resampled sides (§4.5), with
 //!   automatic corners ([`corners`], §4.2) or corners given by the user;
+//! * [`bspline_maps`]: bilinear and (where certified) biquadratic B-spline maps of every block
+//!   of a block mesh (seed 003, crate [`bspline`]);
+//! * [`pde`]: the elliptic PDE solver on convex structured grids and singularity-free quad
+//!   meshes (seed 001 RF12: 9-point transformed stencil, SOR with automatic ω, sparse LU with
+//!   the `direct` feature), with manufactured solutions for verification;
 //! * quality reports ([`mesh::quality::QualityReport`]) and file formats ([`io`]).
 //!
 //! ```
@@ -25,11 +30,15 @@
 
 #![warn(missing_docs)]
 
+pub mod bspline_maps;
 pub mod corners;
+pub mod hex;
+pub mod pde;
 pub mod pipeline;
 pub mod render;
 pub mod single_block;
 
+pub use unamalla_bspline as bspline;
 pub use unamalla_compat_ilp as compat_ilp;
 pub use unamalla_contour as contour;
 pub use unamalla_decompose as decompose;
@@ -73,4 +82,10 @@ pub enum CoreError {
     /// The operation does not apply to this region.
     #[error("{0}")]
     Unsupported(String),
+    /// A B-spline map could not be built or certified.
+    #[error(transparent)]
+    Bspline(#[from] unamalla_bspline::BsplineError),
+    /// Submapping (seed 002) failed.
+    #[error(transparent)]
+    Submap(#[from] unamalla_decompose::submap::SubmapError),
 }

@@ -2,7 +2,11 @@
 //!
 //! Stages (seed 000 digest §0.1):
 //!
-//! 1. **simplify** the contour (`unamalla-contour`, default: modified areas, thesis threshold);
+//! 1. **simplify** the contour (`unamalla-contour`, default: modified areas, thesis threshold),
+//!    then remove the boundary features smaller than the target cell size `h` (modified-area
+//!    measure ζ < `c·h²`, [`DEFAULT_FEATURE_FACTOR`] `c = 0.5`,
+//!    [`unamalla_contour::remove_features_below`]): a block side zig-zagging at the cell scale
+//!    admits no convex cells, so such features would leave folded cells behind;
 //! 2. **decompose** into admissible blocks by cuts and choose four corners per block
 //!    (`unamalla-decompose`);
 //! 3. **compatible counts**: every block side is split into curves Q_j (pieces of the original
@@ -15,17 +19,38 @@
 //! 6. **merge** into one conformal mesh without duplicate nodes ([`BlockMesh2::merge`]);
 //! 7. **smooth** the merged mesh with `F = (1−σ)·w·F_AO + σ·H_ω` (seed 000 (6.8)/(6.9)) with the
 //!    ε-convexity guarantee of `unamalla-optim`; region boundary nodes are fixed, **cut nodes are
-//!    free**. The thesis smooths block by block and then each block with its neighbours; one
-//!    global optimization over the whole merged mesh with the same functional is the limit of
-//!    that sequence and is what we do (optionally preceded by per-block local smoothing).
+//!    free**. The thesis smooths block by block and then each block with its neighbours. We
+//!    first untangle every folded block on its own, with its boundary fixed, all blocks in
+//!    parallel ([`unamalla_optim::smooth_each`]; small problems need far fewer iterations), then
+//!    run one global optimization over the whole merged mesh with the same functional (the limit
+//!    of the thesis's sequence), which starts convex wherever the blocks could be untangled
+//!    alone.
 //! 8. **report** quality ([`QualityReport`]) and fidelity (area change, Hausdorff distance of
 //!    the mesh boundary to the input region).
+//!
+//! ## Decomposition strategies ([`Strategy`])
+//!
+//! * [`Strategy::Cuts`] (default): stages 2–6 as above (seed 000).
+//! * [`Strategy::Submap`]: stages 2–6 are replaced by **submapping** (seed 002,
+//!   [`unamalla_decompose::submap`]): vertex classification with the ILP (6)/(8) repair, virtual
+//!   edges for holes from a constrained Delaunay triangulation, edge classification, interval
+//!   assignment ILP (3), computational space, cuts from Corner/Reversal nodes, TFI per piece and
+//!   merge. Smoothing (stage 7) is the same; cut and virtual-edge nodes are interior nodes of the
+//!   merged mesh and therefore free. The target size is `h = √(area/N)` for
+//!   [`MeshSize::Cells`], `h` for [`MeshSize::CellSize`] and (shortest ring edge)/`d` for
+//!   [`MeshSize::Density`]. [`MeshResult::decomposition`] then holds the pieces as blocks
+//!   ([`Submapping::to_decomposition`]) and [`MeshResult::counts`] is `None`.
+//! * [`Strategy::Auto`]: submapping when **every vertex turning angle of the (simplified) region
+//!   is within [`AUTO_ANGLE_TOLERANCE_DEG`] = 10° of a multiple of 90° and the angle-rule labels
+//!   already satisfy `Σ α = 4` on the outer ring and `−4` on each hole**
+//!   ([`unamalla_decompose::submap::prefers_submap`]); otherwise, or if submapping fails, cuts.
 
 use std::time::Instant;
 
 use serde::Serialize;
 use unamalla_compat_ilp::{self as ilp, CompatProblem};
-use unamalla_contour::{simplify_region, SimplifyOptions};
+use unamalla_contour::{remove_features_below, simplify_region, SimplifyOptions};
+use unamalla_decompose::submap::{prefers_submap, submap, SubmapOptions, Submapping};
 use unamalla_decompose::{decompose, DecomposeOptions, Decomposition, EdgeKind};
 use unamalla_mesh::quality::QualityReport;
 use unamalla_mesh::resample::{polyline_length, resample_arc_length};
@@ -33,7 +58,7 @@ use unamalla_mesh::{
     tfi2, BlockMesh2, DVec2, HasNodes, HasQuadCells, Region, StructuredGrid2, TfiParams,
 };
 use unamalla_optim::monitor::{Control, Monitor, NullObserver, Observer};
-use unamalla_optim::{smooth, SmoothOptions};
+use unamalla_optim::{smooth, smooth_each, SmoothOptions};
 
 use crate::CoreError;
 
@@ -53,6 +78,27 @@ impl Default for MeshSize {
         MeshSize::Cells(20_000)
     }
 }
+
+/// The decomposition strategy (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strategy {
+    /// Straight cuts into admissible blocks with four corners (seed 000).
+    #[default]
+    Cuts,
+    /// Submapping (seed 002).
+    Submap,
+    /// Submapping when all angles are near multiples of 90°, else cuts.
+    Auto,
+}
+
+/// Default factor `c` of [`Mesher::feature_factor`]: boundary features with ζ < `c·h²` are
+/// removed (spikes and zig-zags narrower than about 0.7 cell; chord error ≈ `h/11` on smooth
+/// stretches).
+pub const DEFAULT_FEATURE_FACTOR: f64 = 0.5;
+
+/// Angle tolerance (degrees) of the [`Strategy::Auto`] rule.
+pub const AUTO_ANGLE_TOLERANCE_DEG: f64 = 10.0;
 
 /// A stage of the pipeline, for progress callbacks and timings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -94,7 +140,9 @@ pub struct Mesher {
     smooth_opts: SmoothOptions,
     boundary_density: f64,
     smooth_budget: f64,
+    feature_factor: f64,
     progress: Option<ProgressFn>,
+    strategy: Strategy,
 }
 
 impl Default for Mesher {
@@ -107,10 +155,13 @@ impl Default for Mesher {
 pub struct MeshResult {
     /// The region after simplification (the mesh's boundary lies on it).
     pub simplified: Region,
-    /// The decomposition used.
+    /// The decomposition used (for [`Strategy::Submap`]: the pieces as blocks).
     pub decomposition: Decomposition,
-    /// The compatible counts per curve and the block sizes.
-    pub counts: ilp::CompatSolution,
+    /// The compatible counts per curve and the block sizes (`None` when submapping made the
+    /// blocks; its interval counts are in [`MeshResult::submap`]).
+    pub counts: Option<ilp::CompatSolution>,
+    /// The submapping, when that strategy was used.
+    pub submap: Option<Submapping>,
     /// The block-structured mesh (blocks + conformal global mesh).
     pub mesh: BlockMesh2,
     /// The report.
@@ -128,6 +179,8 @@ pub struct MeshReport {
     pub nodes: usize,
     /// Number of blocks.
     pub blocks: usize,
+    /// The decomposition strategy that made the blocks (`cuts` or `submap`).
+    pub strategy: Strategy,
     /// Cells with a non-positive corner triangle.
     pub non_convex_cells: usize,
     /// Interior nodes with valence ≠ 4.
@@ -170,8 +223,24 @@ impl Mesher {
             smooth_opts: default_smooth_options(),
             boundary_density: 1.0,
             smooth_budget: 20.0,
+            feature_factor: DEFAULT_FEATURE_FACTOR,
             progress: None,
+            strategy: Strategy::Cuts,
         }
+    }
+    /// The decomposition strategy (default [`Strategy::Cuts`]).
+    pub fn strategy(mut self, s: Strategy) -> Self {
+        self.strategy = s;
+        self
+    }
+    /// Boundary features whose modified-area measure ζ (seed 000 (3.4)) is below
+    /// `c·h²` are removed after the contour simplification, `h` the target cell size
+    /// (default [`DEFAULT_FEATURE_FACTOR`]; 0 disables; see
+    /// [`unamalla_contour::remove_features_below`]). Not applied with `--density` sizes (no
+    /// `h`), without simplification, or with a decomposition file.
+    pub fn feature_factor(mut self, c: f64) -> Self {
+        self.feature_factor = if c.is_finite() { c.max(0.0) } else { 0.0 };
+        self
     }
     /// About `n` cells.
     pub fn cells(mut self, n: usize) -> Self {
@@ -229,6 +298,24 @@ impl Mesher {
         self
     }
 
+    /// Target size of the submapping strategy (see the module documentation).
+    fn submap_size(&self, region: &Region) -> f64 {
+        match self.size {
+            MeshSize::Cells(n) => (region.area() / n.max(1) as f64).sqrt(),
+            MeshSize::CellSize(h) => h,
+            MeshSize::Density(d) => {
+                let shortest = region
+                    .rings()
+                    .flat_map(|r| {
+                        let p = r.points();
+                        (0..p.len()).map(move |i| p[i].distance(p[(i + 1) % p.len()]))
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                shortest / d.max(1) as f64
+            }
+        }
+    }
+
     fn stage(&mut self, s: Stage, msg: &str) {
         if let Some(f) = self.progress.as_mut() {
             f(s, msg);
@@ -264,47 +351,100 @@ impl Mesher {
             }
             None => (region.clone(), Vec::new()),
         };
+        // 1b. features below the cell size (not with a decomposition file, which was made
+        // for the region as simplified by the method alone)
+        let h = match self.size {
+            MeshSize::Cells(n) => Some((simplified.area() / n.max(1) as f64).sqrt()),
+            MeshSize::CellSize(h) => Some(h),
+            MeshSize::Density(_) => None,
+        };
+        let simplified = match (h, &self.simplify, &self.decomposition) {
+            (Some(h), Some(_), None) if self.feature_factor > 0.0 => {
+                remove_features_below(&simplified, self.feature_factor * h * h)?
+            }
+            _ => simplified,
+        };
         lap(Stage::Simplify, &mut timer);
 
-        // 2. decompose
-        self.stage(Stage::Decompose, "decomposing into blocks");
-        let decomposition = match self.decomposition.take() {
-            Some(d) => {
-                d.validate(&simplified)?;
-                d
+        // 2–6 by submapping (seed 002) when the strategy asks for it
+        let submapping = match (self.strategy, self.decomposition.is_some()) {
+            (Strategy::Submap, true) => {
+                return Err(CoreError::Unsupported(
+                    "a decomposition file and the submap strategy exclude each other".into(),
+                ))
             }
-            None => decompose(&simplified, &self.decompose_opts)?,
-        };
-        lap(Stage::Decompose, &mut timer);
-
-        // 3. compatible counts
-        self.stage(Stage::Counts, "solving for compatible point counts");
-        let curves = BlockCurves::new(&decomposition);
-        let problem = curves.problem();
-        let bounds = match self.size {
-            MeshSize::Cells(n) => {
-                let n = n.max(1) as f64;
-                ilp::LowerBounds::CellSize((simplified.area() / n).sqrt())
+            (Strategy::Submap, false) => {
+                self.stage(Stage::Decompose, "submapping (seed 002)");
+                Some(submap(
+                    &simplified,
+                    &SubmapOptions::new(self.submap_size(&simplified)),
+                )?)
             }
-            MeshSize::CellSize(h) => ilp::LowerBounds::CellSize(h),
-            MeshSize::Density(d) => ilp::LowerBounds::Density(d.max(1)),
+            (Strategy::Auto, false) if prefers_submap(&simplified, AUTO_ANGLE_TOLERANCE_DEG) => {
+                self.stage(Stage::Decompose, "submapping (seed 002, automatic choice)");
+                submap(
+                    &simplified,
+                    &SubmapOptions::new(self.submap_size(&simplified)),
+                )
+                .ok()
+            }
+            _ => None,
         };
-        let solve_opts = ilp::SolveOptions {
-            bounds,
-            ..ilp::SolveOptions::default()
+        let (decomposition, counts, mut mesh) = match submapping.as_ref() {
+            Some(s) => {
+                lap(Stage::Decompose, &mut timer);
+                lap(Stage::Counts, &mut timer);
+                self.stage(Stage::Tfi, "transfinite interpolation per piece");
+                let grids = s.grids()?;
+                lap(Stage::Tfi, &mut timer);
+                self.stage(Stage::Merge, "merging pieces");
+                let mesh = BlockMesh2::merge(grids, 1e-9)?;
+                lap(Stage::Merge, &mut timer);
+                (s.to_decomposition(), None, mesh)
+            }
+            None => {
+                // 2. decompose
+                self.stage(Stage::Decompose, "decomposing into blocks");
+                let decomposition = match self.decomposition.take() {
+                    Some(d) => {
+                        d.validate(&simplified)?;
+                        d
+                    }
+                    None => decompose(&simplified, &self.decompose_opts)?,
+                };
+                lap(Stage::Decompose, &mut timer);
+
+                // 3. compatible counts
+                self.stage(Stage::Counts, "solving for compatible point counts");
+                let curves = BlockCurves::new(&decomposition);
+                let problem = curves.problem();
+                let bounds = match self.size {
+                    MeshSize::Cells(n) => {
+                        let n = n.max(1) as f64;
+                        ilp::LowerBounds::CellSize((simplified.area() / n).sqrt())
+                    }
+                    MeshSize::CellSize(h) => ilp::LowerBounds::CellSize(h),
+                    MeshSize::Density(d) => ilp::LowerBounds::Density(d.max(1)),
+                };
+                let solve_opts = ilp::SolveOptions {
+                    bounds,
+                    ..ilp::SolveOptions::default()
+                };
+                let counts = ilp::solve(&problem, &solve_opts)?;
+                lap(Stage::Counts, &mut timer);
+
+                // 4–5. reparametrize + TFI
+                self.stage(Stage::Tfi, "transfinite interpolation per block");
+                let grids = curves.grids(&decomposition, &counts.counts)?;
+                lap(Stage::Tfi, &mut timer);
+
+                // 6. merge
+                self.stage(Stage::Merge, "merging blocks");
+                let mesh = BlockMesh2::merge(grids, 1e-9)?;
+                lap(Stage::Merge, &mut timer);
+                (decomposition, Some(counts), mesh)
+            }
         };
-        let counts = ilp::solve(&problem, &solve_opts)?;
-        lap(Stage::Counts, &mut timer);
-
-        // 4–5. reparametrize + TFI
-        self.stage(Stage::Tfi, "transfinite interpolation per block");
-        let grids = curves.grids(&decomposition, &counts.counts)?;
-        lap(Stage::Tfi, &mut timer);
-
-        // 6. merge
-        self.stage(Stage::Merge, "merging blocks");
-        let mut mesh = BlockMesh2::merge(grids, 1e-9)?;
-        lap(Stage::Merge, &mut timer);
 
         // 7. smooth (region boundary fixed, cut nodes free)
         self.stage(Stage::Smooth, "smoothing (convexity-preserving)");
@@ -316,6 +456,20 @@ impl Mesher {
         }
         let budget = self.smooth_budget;
         let started = Instant::now();
+        // 7a. untangle folded blocks one by one, each with its own boundary fixed, in
+        // parallel: small problems converge in far fewer iterations than the global one, and
+        // the global run below then starts convex (or nearly so)
+        // (at most half the budget: blocks that cannot be untangled with their boundary fixed
+        // are left to the global run, where cut nodes move)
+        let deadline = started + std::time::Duration::from_secs_f64(0.5 * budget.max(0.0));
+        let folded = |g: &StructuredGrid2| {
+            g.m() > 2 && g.n() > 2 && !unamalla_mesh::quality::non_convex_cells(g).is_empty()
+        };
+        let per_block = smooth_each(mesh.blocks_mut(), folded, &sopts, Some(deadline));
+        for r in per_block.into_iter().flatten() {
+            r?;
+        }
+        mesh.sync_global();
         let mut budgeted = |m: &Monitor| {
             if observer.observe(m) == Control::Stop {
                 return Control::Stop;
@@ -347,6 +501,11 @@ impl Mesher {
             cells: mesh.num_quads(),
             nodes: mesh.num_nodes(),
             blocks: mesh.blocks().len(),
+            strategy: if submapping.is_some() {
+                Strategy::Submap
+            } else {
+                Strategy::Cuts
+            },
             non_convex_cells: quality.non_convex_cells,
             interior_singularities: q.map_or(0, |q| q.interior_singularities),
             mu_ge_0_8_percent: q.map_or(0.0, |q| q.mu_bands.good),
@@ -368,6 +527,7 @@ impl Mesher {
             simplified,
             decomposition,
             counts,
+            submap: submapping,
             mesh,
             report,
         })

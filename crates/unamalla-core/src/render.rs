@@ -1,7 +1,9 @@
 //! Pictures of meshes: each cell coloured by the "rectangles 2015" measure μ, as in the thesis
 //! (seed 000 digest §1.4): blue μ ≥ 0.8, orange 0.4 ≤ μ < 0.8, red μ < 0.4 (non-convex cells
-//! have μ ≤ 0 and are red). SVG through [`unamalla_mesh::svg`], PNG rasterized with
-//! `tiny-skia` (pure Rust) and encoded by its PNG writer.
+//! have μ ≤ 0 and are red) — or, for a nodal field such as a PDE solution ([`field_png`],
+//! [`field_svg`]), by a continuous colour scale ([`field_color`]). SVG through
+//! [`unamalla_mesh::svg`], PNG rasterized with `tiny-skia` (pure Rust) and encoded by its PNG
+//! writer; both kinds share one drawing routine per format.
 
 use unamalla_mesh::quality::mu;
 use unamalla_mesh::svg::{Style, SvgCanvas};
@@ -45,12 +47,99 @@ pub fn quality_svg<M: HasQuadCells + ?Sized>(
     region: Option<&Region>,
     width_px: f64,
 ) -> String {
+    cells_svg(mesh, region, width_px, &|_, q| mu_color(mu(q)))
+}
+
+/// The colour of `t ∈ [0, 1]` on a blue → green → yellow scale (piecewise-linear through five
+/// stops of matplotlib's *viridis*, perceptually ordered and readable in grey); `t` outside
+/// `[0, 1]` is clamped, NaN gives the low end.
+pub fn field_color(t: f64) -> [u8; 3] {
+    const STOPS: [[f64; 3]; 5] = [
+        [68.0, 1.0, 84.0],
+        [59.0, 82.0, 139.0],
+        [33.0, 145.0, 140.0],
+        [94.0, 201.0, 98.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let x = t * 4.0;
+    let k = (x.floor() as usize).min(3);
+    let f = x - k as f64;
+    std::array::from_fn(|c| (STOPS[k][c] * (1.0 - f) + STOPS[k + 1][c] * f).round() as u8)
+}
+
+/// Per-cell colours of a nodal field: each cell gets [`field_color`] of the mean of its four
+/// node values, scaled so that the field's minimum is 0 and its maximum 1.
+fn field_cell_colour(values: &[f64]) -> impl Fn(usize, &[DVec2; 4], [usize; 4]) -> [u8; 3] + '_ {
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    move |_, _, ids| {
+        let mean = ids.iter().map(|&k| values[k]).sum::<f64>() / 4.0;
+        field_color((mean - lo) / span)
+    }
+}
+
+fn check_field<M: HasQuadCells + ?Sized>(mesh: &M, values: &[f64]) -> Result<(), CoreError> {
+    if values.len() != mesh.num_nodes() {
+        return Err(CoreError::Unsupported(format!(
+            "a nodal field needs one value per node: {} values for {} nodes",
+            values.len(),
+            mesh.num_nodes()
+        )));
+    }
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Err(CoreError::Unsupported(format!(
+            "the nodal field is not finite at node {k}"
+        )));
+    }
+    Ok(())
+}
+
+/// An SVG colour plot of a nodal field (e.g. a PDE solution) on a quad mesh: cells coloured
+/// by [`field_color`] of the mean of their node values, min → dark blue, max → yellow.
+pub fn field_svg<M: HasQuadCells + ?Sized>(
+    mesh: &M,
+    values: &[f64],
+    region: Option<&Region>,
+    width_px: f64,
+) -> Result<String, CoreError> {
+    check_field(mesh, values)?;
+    let col = field_cell_colour(values);
+    Ok(cells_svg(mesh, region, width_px, &|c, q| {
+        col(c, q, mesh.quad(c))
+    }))
+}
+
+/// A PNG colour plot of a nodal field (encoded bytes), `width_px` wide (see [`field_svg`]).
+pub fn field_png<M: HasQuadCells + ?Sized>(
+    mesh: &M,
+    values: &[f64],
+    region: Option<&Region>,
+    width_px: u32,
+) -> Result<Vec<u8>, CoreError> {
+    check_field(mesh, values)?;
+    let col = field_cell_colour(values);
+    cells_png(mesh, region, width_px, &|c, q| col(c, q, mesh.quad(c)))
+}
+
+/// Cells filled with `colour(cell, points)`, edges when there are fewer than 40,000 cells,
+/// region rings on top.
+fn cells_svg<M: HasQuadCells + ?Sized>(
+    mesh: &M,
+    region: Option<&Region>,
+    width_px: f64,
+    colour: &dyn Fn(usize, &[DVec2; 4]) -> [u8; 3],
+) -> String {
     let (lo, hi) = bounds(mesh);
     let mut c = SvgCanvas::new(lo, hi, width_px);
     let edges = mesh.num_quads() < 40_000;
     for k in 0..mesh.num_quads() {
         let q = mesh.quad_points(k);
-        let col = hex(mu_color(mu(&q)));
+        let col = hex(colour(k, &q));
         let style = if edges {
             Style::fill_stroke(&col, "#333333", 0.2)
         } else {
@@ -73,6 +162,17 @@ pub fn quality_png<M: HasQuadCells + ?Sized>(
     mesh: &M,
     region: Option<&Region>,
     width_px: u32,
+) -> Result<Vec<u8>, CoreError> {
+    cells_png(mesh, region, width_px, &|_, q| mu_color(mu(q)))
+}
+
+/// Rasterizes cells filled with `colour(cell, points)` (tiny-skia), edges when there are
+/// fewer than 20,000 cells, region rings on top; returns the encoded PNG.
+fn cells_png<M: HasQuadCells + ?Sized>(
+    mesh: &M,
+    region: Option<&Region>,
+    width_px: u32,
+    colour: &dyn Fn(usize, &[DVec2; 4]) -> [u8; 3],
 ) -> Result<Vec<u8>, CoreError> {
     use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
     let (lo, hi) = bounds(mesh);
@@ -110,7 +210,7 @@ pub fn quality_png<M: HasQuadCells + ?Sized>(
         }
         pb.close();
         let Some(path) = pb.finish() else { continue };
-        let [r, g, b] = mu_color(mu(&q));
+        let [r, g, b] = colour(k, &q);
         paint.set_color_rgba8(r, g, b, 255);
         pix.fill_path(
             &path,
@@ -163,6 +263,32 @@ mod tests {
         assert_eq!(mu_color(0.5), ORANGE);
         assert_eq!(mu_color(0.1), RED);
         assert_eq!(mu_color(-1.0), RED);
+    }
+
+    #[test]
+    fn field_plot_colours_follow_the_values() {
+        assert_eq!(field_color(0.0), [68, 1, 84]);
+        assert_eq!(field_color(0.5), [33, 145, 140]);
+        assert_eq!(field_color(1.0), [253, 231, 37]);
+        assert_eq!(field_color(f64::NAN), [68, 1, 84]);
+        // two unit cells, field u = x ∈ [0, 2]: the left cell's mean 0.5 maps to t = 0.25
+        // (stop 1, #3b528b), the right cell's mean 1.5 to t = 0.75 (stop 3, #5ec962)
+        let g = StructuredGrid2::from_fn(3, 2, |i, j| DVec2::new(i as f64, j as f64)).unwrap();
+        let u: Vec<f64> = (0..6).map(|k| (k % 3) as f64).collect();
+        let svg = field_svg(&g, &u, None, 200.0).unwrap();
+        assert!(svg.contains("#3b528b") && svg.contains("#5ec962"), "{svg}");
+        let png = field_png(&g, &u, None, 200).unwrap();
+        let pix = tiny_skia::Pixmap::decode_png(&png).unwrap();
+        let scale = (200.0 - 20.0) / 2.0;
+        let c = pix
+            .pixel(
+                (10.0 + 0.5 * scale) as u32,
+                (pix.height() as f64 - 10.0 - 0.5 * scale) as u32,
+            )
+            .unwrap();
+        assert_eq!([c.red(), c.green(), c.blue()], [59, 82, 139]);
+        assert!(field_png(&g, &u[..5], None, 200).is_err());
+        assert!(field_svg(&g, &[f64::NAN; 6], None, 200.0).is_err());
     }
 
     #[test]

@@ -114,6 +114,15 @@
 //! the triangle-block rule (two points inserted near each critical vertex, on its two edges,
 //! at the same distance).
 //!
+//! ## Submapping (seed 002)
+//!
+//! Module [`submap`] is the second strategy: vertex classification by turning angles with the ILP
+//! (6)/(8) repair, virtual edges for holes from a constrained Delaunay triangulation, interval
+//! assignment ILP (3), the integer computational space and cuts from Corner/Reversal nodes until
+//! every piece is a computational rectangle ([`submap::submap`]); the pieces can be TFI'd and merged
+//! ([`submap::Submapping::block_mesh`]) or viewed as a [`Decomposition`]
+//! ([`submap::Submapping::to_decomposition`]).
+//!
 //! ## Files and pictures
 //!
 //! The decomposition file (module [`file`](mod@file)) saves any result and overrides any part of it
@@ -132,6 +141,7 @@ pub mod file;
 mod geom;
 mod piece;
 mod render;
+pub mod submap;
 
 pub use auto::{decompose, CutWeights, DecomposeOptions};
 pub use concavity::{concavity, critical_angles, is_admissible, Concavity, Pocket, Tolerances};

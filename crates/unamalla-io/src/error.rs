@@ -239,6 +239,32 @@ pub enum IoError {
         value: f64,
     },
 
+    /// A point data array given to a writer does not have one value per node.
+    #[error("{}: point array {name:?} has {found} values, the mesh has {expected} nodes", .path.display())]
+    PointDataLength {
+        /// The target file.
+        path: PathBuf,
+        /// The array name.
+        name: String,
+        /// Number of nodes.
+        expected: usize,
+        /// Number of values given.
+        found: usize,
+    },
+
+    /// A point data value given to a writer is NaN or infinite.
+    #[error("{}: point array {name:?}, node {node}: non-finite value {value}", .path.display())]
+    NonFinitePointValue {
+        /// The target file.
+        path: PathBuf,
+        /// The array name.
+        name: String,
+        /// The node.
+        node: usize,
+        /// The value.
+        value: f64,
+    },
+
     /// A data array name given to a writer is not usable (empty, whitespace or control
     /// characters, non-ASCII, or a duplicate). Names are rejected, never silently changed.
     #[error("{}: invalid array name {name:?}: {reason}", .path.display())]

@@ -83,6 +83,9 @@
 //! ```
 
 #![warn(missing_docs)]
+// No unwrap/expect in library code: user input must give an error, never a panic (issue #14,
+// docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod atomic;
 pub mod error;
@@ -122,14 +125,17 @@ pub use plot3d::{
 pub use rings::{
     parse_region_text, parse_rings_text, read_region_text, read_rings_text, write_region_text,
 };
-pub use shp::{read_region_shapefile, read_shapefile_parts, write_region_shapefile};
+pub use shp::{
+    parse_shapefile_parts, read_region_shapefile, read_shapefile_parts, write_region_shapefile,
+};
 pub use surface::{
     parse_obj, parse_off, read_obj, read_off, write_obj_hexes, write_obj_quads, write_off_hexes,
     write_off_quads, SurfaceMesh,
 };
 pub use vtk::{
-    parse_vtk, read_vtk, write_vtk_hexes, write_vtk_quads, write_vtk_structured2,
-    write_vtk_structured3, VtkFile, VtkMesh,
+    parse_vtk, read_vtk, write_vtk_hexes, write_vtk_quads, write_vtk_quads_with_point_data,
+    write_vtk_structured2, write_vtk_structured2_with_point_data, write_vtk_structured3, VtkFile,
+    VtkMesh,
 };
 pub use vtk_xml::{
     parse_vtk_xml, read_vtk_xml, read_vtm, write_block_mesh, write_vtm, write_vts2, write_vts3,

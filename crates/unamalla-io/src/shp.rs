@@ -14,7 +14,9 @@
 //! used). [`write_region_shapefile`] writes the `.shp` and its `.shx` index (both atomically,
 //! the `.shp` last) with one polygon shape; attribute tables (`.dbf`) are not written.
 //! Reader errors are reported as [`IoError::Shapefile`] with the crate's message (the format is
-//! binary, so there are no line numbers).
+//! binary, so there are no line numbers), except record headers whose sizes or point counts do
+//! not fit in the file, which are checked first and reported as [`IoError::MalformedBinary`]
+//! with the byte offset (so no input makes the reader reserve more memory than the file size).
 
 use std::io::Cursor;
 use std::path::Path;
@@ -43,6 +45,12 @@ pub fn read_shapefile_parts(path: impl AsRef<Path>) -> Result<Vec<PolygonRings>,
         source,
     })?;
     parts_from_bytes(&bytes, path)
+}
+
+/// Every polygonal part of a shapefile held in memory (the bytes of a `.shp` file), like
+/// [`read_shapefile_parts`]; errors name the path `<string>`.
+pub fn parse_shapefile_parts(bytes: &[u8]) -> Result<Vec<PolygonRings>, IoError> {
+    parts_from_bytes(bytes, Path::new(crate::geojson::STRING_SOURCE))
 }
 
 /// Reads a region from a shapefile: the selected part, validated by [`Region::new`].
@@ -82,7 +90,111 @@ fn inside(p: DVec2, ring: &[DVec2]) -> bool {
     c
 }
 
+fn le_i32(bytes: &[u8], at: usize) -> Option<i64> {
+    let b: [u8; 4] = bytes.get(at..at.checked_add(4)?)?.try_into().ok()?;
+    Some(i64::from(i32::from_le_bytes(b)))
+}
+
+fn be_i32(bytes: &[u8], at: usize) -> Option<i64> {
+    let b: [u8; 4] = bytes.get(at..at.checked_add(4)?)?.try_into().ok()?;
+    Some(i64::from(i32::from_be_bytes(b)))
+}
+
+/// Checks the record headers and point counts of a `.shp` file before the [`shapefile`] crate
+/// reads it: every record must fit in the file, and a record's declared part and point counts
+/// must fit in its content (ESRI whitepaper: polygon/polyline content = 44 + 4·parts + 16·points
+/// bytes at least, multipoint 40 + 16·points), and part start indices must be non-decreasing
+/// and at most the point count. The crate reserves memory for the declared
+/// counts before reading them, so without this check a 300-byte file could ask for gigabytes
+/// (found by the `shapefile` fuzz target, issue #14). Records are walked like the crate does
+/// without an index: from byte 100, while below the header's file length.
+fn check_records(bytes: &[u8], path: &Path) -> Result<(), IoError> {
+    let bad = |offset: usize, message: String| IoError::MalformedBinary {
+        path: path.to_path_buf(),
+        offset: offset as u64,
+        message,
+    };
+    // not a shapefile, or too short for a header: the crate reports it
+    let (Some(9994), Some(words)) = (be_i32(bytes, 0), be_i32(bytes, 24)) else {
+        return Ok(());
+    };
+    let declared = usize::try_from(words.max(0)).unwrap_or(0).saturating_mul(2);
+    let end = declared.min(bytes.len());
+    let mut pos = 100usize;
+    let mut record = 0usize;
+    while pos.saturating_add(8) <= end {
+        let words = be_i32(bytes, pos + 4).unwrap_or(0);
+        let content = match usize::try_from(words) {
+            Ok(w) => w.saturating_mul(2),
+            Err(_) => {
+                return Err(bad(
+                    pos + 4,
+                    format!("record {record}: negative content length {words}"),
+                ))
+            }
+        };
+        let start = pos + 8;
+        if content > bytes.len() - start {
+            return Err(bad(
+                pos + 4,
+                format!(
+                    "record {record}: content length {content} bytes runs past the end of the file ({} bytes)",
+                    bytes.len()
+                ),
+            ));
+        }
+        let shape_type = le_i32(bytes, start).unwrap_or(0);
+        let (fixed, parts_at, points_at) = match shape_type {
+            3 | 5 | 13 | 15 | 23 | 25 | 31 => (44i64, Some(start + 36), start + 40),
+            8 | 18 | 28 => (40i64, None, start + 36),
+            _ => (0, None, 0),
+        };
+        // the crate reads the shape type and the fixed fields whatever the record length says
+        if content < 4 || (fixed > 0 && (content as i64) < fixed) {
+            return Err(bad(
+                pos + 4,
+                format!(
+                    "record {record}: content length {content} bytes is too short for shape type {shape_type}"
+                ),
+            ));
+        }
+        if fixed > 0 {
+            let parts = parts_at.and_then(|at| le_i32(bytes, at)).unwrap_or(0);
+            let points = le_i32(bytes, points_at).unwrap_or(0);
+            let need = fixed + 4 * parts + 16 * points;
+            if parts < 0 || points < 0 || need > content as i64 {
+                return Err(bad(
+                    start + 36,
+                    format!(
+                        "record {record}: {parts} part(s) and {points} point(s) need {need} bytes, the record has {content}"
+                    ),
+                ));
+            }
+            // part start indices: non-decreasing, within 0..=points (the crate derives each
+            // part's point count from consecutive indices and reserves that much)
+            let mut prev = 0i64;
+            for k in 0..parts as usize {
+                let at = start + 44 + 4 * k;
+                let idx = le_i32(bytes, at).unwrap_or(-1);
+                if idx < prev || idx > points {
+                    return Err(bad(
+                        at,
+                        format!(
+                            "record {record}: part {k} starts at point {idx}, outside {prev}..={points}"
+                        ),
+                    ));
+                }
+                prev = idx;
+            }
+        }
+        pos = start + content;
+        record += 1;
+    }
+    Ok(())
+}
+
 fn parts_from_bytes(bytes: &[u8], path: &Path) -> Result<Vec<PolygonRings>, IoError> {
+    check_records(bytes, path)?;
     let reader = ShapeReader::new(Cursor::new(bytes)).map_err(|e| shp_err(path, e))?;
     let shapes = reader.read().map_err(|e| shp_err(path, e))?;
     let mut parts: Vec<PolygonRings> = Vec::new();

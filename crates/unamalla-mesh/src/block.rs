@@ -130,6 +130,27 @@ impl BlockMesh2 {
     pub fn block_node_map(&self, b: usize) -> &[usize] {
         &self.block_nodes[b]
     }
+    /// Mutable access to the blocks, for work done block by block with each block's boundary
+    /// fixed (e.g. per-block untangling); call [`BlockMesh2::sync_global`] afterwards.
+    pub fn blocks_mut(&mut self) -> &mut [StructuredGrid2] {
+        &mut self.blocks
+    }
+    /// Copies every block's **interior** node coordinates into the global mesh (the inverse of
+    /// [`BlockMesh2::sync_blocks`] for nodes owned by one block). Block boundary nodes — the
+    /// ones blocks share — are left as the global mesh has them, so blocks edited with their
+    /// boundaries fixed stay conformal.
+    pub fn sync_global(&mut self) {
+        let nodes = self.global.nodes_mut();
+        for (b, map) in self.blocks.iter().zip(&self.block_nodes) {
+            let (m, n) = (b.m(), b.n());
+            for j in 1..n.saturating_sub(1) {
+                for i in 1..m.saturating_sub(1) {
+                    let k = j * m + i;
+                    nodes[map[k]] = b.nodes()[k];
+                }
+            }
+        }
+    }
     /// Copies the global node coordinates back into every block.
     pub fn sync_blocks(&mut self) {
         let nodes = self.global.nodes();
@@ -198,6 +219,24 @@ mod tests {
         bm.sync_blocks();
         assert_eq!(bm.blocks()[0].node(2, 1), DVec2::new(2.1, 1.05));
         assert_eq!(bm.blocks()[1].node(0, 1), DVec2::new(2.1, 1.05));
+    }
+
+    #[test]
+    fn sync_global_copies_block_interiors_and_keeps_shared_nodes() {
+        // [0,2]×[0,2] and [2,4]×[0,2], 3×3 nodes each: one interior node per block, (1,1) and
+        // (3,1); the shared side x = 2 is a block boundary
+        let mut bm = BlockMesh2::merge(vec![grid(0., 0., 3, 3), grid(2., 0., 3, 3)], 1e-9).unwrap();
+        bm.blocks_mut()[0].nodes_mut()[4] = DVec2::new(0.9, 1.2); // (1,1) of block 0
+        bm.blocks_mut()[1].nodes_mut()[4] = DVec2::new(3.2, 0.8); // (1,1) of block 1
+        bm.blocks_mut()[1].nodes_mut()[3] = DVec2::new(9.0, 9.0); // (0,1) of block 1: shared
+        bm.sync_global();
+        let g0 = bm.block_node_map(0)[4];
+        let g1 = bm.block_node_map(1)[4];
+        let gs = bm.block_node_map(1)[3];
+        assert_eq!(bm.nodes()[g0], DVec2::new(0.9, 1.2));
+        assert_eq!(bm.nodes()[g1], DVec2::new(3.2, 0.8));
+        // the shared node is a block-boundary node: not copied
+        assert_eq!(bm.nodes()[gs], DVec2::new(2.0, 1.0));
     }
 
     #[test]

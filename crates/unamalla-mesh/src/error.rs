@@ -44,6 +44,21 @@ pub enum GeometryError {
         /// Its y coordinate.
         y: f64,
     },
+    /// A coordinate is finite but outside the range the exact predicates handle: non-zero
+    /// magnitudes must lie in [`MIN_COORDINATE`](crate::region::MIN_COORDINATE) ..=
+    /// [`MAX_COORDINATE`](crate::region::MAX_COORDINATE) (products of coordinate differences
+    /// must neither overflow nor underflow).
+    #[error("{ring}, vertex {vertex}: coordinate ({x:e}, {y:e}) is out of range; non-zero coordinates must have magnitudes between 1e-100 and 1e150")]
+    CoordinateOutOfRange {
+        /// The ring.
+        ring: RingId,
+        /// The vertex.
+        vertex: usize,
+        /// Its x coordinate.
+        x: f64,
+        /// Its y coordinate.
+        y: f64,
+    },
     /// Two consecutive points coincide (use the cleaning constructor to drop them).
     #[error("{ring}, vertex {vertex}: repeats the previous point; use Region::new_cleaned to remove repeated points")]
     RepeatedPoint {

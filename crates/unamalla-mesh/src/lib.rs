@@ -17,6 +17,7 @@ pub mod block;
 pub mod error;
 pub mod geometry;
 pub mod grid;
+pub mod hexgen;
 pub mod quality;
 pub mod refine;
 pub mod region;

@@ -8,7 +8,8 @@
 //!
 //! Validation (exact predicates, R*-tree over all edges, O(n log n)) rejects with a typed
 //! [`GeometryError`] naming the ring and vertex/edge: fewer than 3 distinct points, non-finite
-//! coordinates, repeated consecutive points ([`Region::new_cleaned`] removes them instead),
+//! coordinates, coordinates outside the exact predicates' range ([`MIN_COORDINATE`] ..=
+//! [`MAX_COORDINATE`] in magnitude, or 0), repeated consecutive points ([`Region::new_cleaned`] removes them instead),
 //! zero-area rings, self-intersecting rings (including zero-angle spikes), rings that touch or
 //! cross each other, holes outside the outer ring and nested holes.
 
@@ -18,6 +19,17 @@ use serde::{Deserialize, Serialize};
 use crate::error::{GeometryError, RingId};
 use crate::geometry::{self, locate_in_ring, Location};
 use crate::spatial::SegmentIndex;
+
+/// Largest accepted coordinate magnitude. Shewchuk's `orient2d` is exact only while the
+/// products of coordinate differences do not overflow: differences ≤ 2·10¹⁵⁰ give products
+/// ≤ 4·10³⁰⁰ < f64::MAX. Larger coordinates made `orient2d` return ±∞/NaN and validation accept
+/// self-intersecting or misoriented rings (found by the `region` fuzz target, issue #14).
+pub const MAX_COORDINATE: f64 = 1e150;
+
+/// Smallest accepted non-zero coordinate magnitude (zero is accepted). Two distinct doubles of
+/// magnitude ≥ 10⁻¹⁰⁰ differ by at least ~10⁻¹¹⁶, so the products inside `orient2d` stay far
+/// above the subnormal range (2.2·10⁻³⁰⁸) where they would lose exactness.
+pub const MIN_COORDINATE: f64 = 1e-100;
 
 /// A simple polygon stored as an open ring of points.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -119,13 +131,39 @@ impl Polygon {
 }
 
 /// Shoelace signed area of an open ring (positive = counter-clockwise).
+///
+/// Computed as the fan `½ Σ_k (p_k − p_0) × (p_{k+1} − p_0)` from the first vertex — equal to
+/// the textbook `½ Σ_k p_k × p_{k+1}` in exact arithmetic (the shoelace sum is invariant
+/// under translation), but in floating point the textbook form cancels catastrophically far
+/// from the origin: for a ring near (10⁹, 10⁹) the products are ~10¹⁸ and their rounding
+/// errors ~10², larger than the area of a 10 × 10 ring (found by the `region` fuzz target,
+/// issue #14). Relative to `p_0` the error scales with the ring's own extent.
 pub fn signed_area(ring: &[DVec2]) -> f64 {
-    let n = ring.len();
+    let Some(&o) = ring.first() else {
+        return 0.0;
+    };
     let mut s = 0.0;
-    for k in 0..n {
-        s += ring[k].perp_dot(ring[(k + 1) % n]);
+    for w in ring.windows(2).skip(1) {
+        s += (w[0] - o).perp_dot(w[1] - o);
     }
     0.5 * s
+}
+
+/// Exact orientation of a simple ring: the sign of `orient2d` at its lexicographically
+/// smallest vertex (smallest x, then smallest y). That vertex is a strictly convex corner of
+/// any simple ring (its neighbours cannot both be collinear with it without a zero-angle
+/// spike, which validation rejects), so the sign is that of the ring's area, decided
+/// exactly instead of from a rounded area. Returns > 0 for counter-clockwise.
+fn exact_orientation(ring: &[DVec2]) -> f64 {
+    let n = ring.len();
+    let Some((k, _)) = ring
+        .iter()
+        .enumerate()
+        .min_by(|(_, a), (_, b)| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)))
+    else {
+        return 0.0;
+    };
+    geometry::orient2d(ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n])
 }
 
 /// A validated polygonal region: outer ring (CCW) and holes (CW).
@@ -232,12 +270,12 @@ impl Region {
             .map(|r| Polygon::from_points_unchecked(r.clone()))
             .collect();
         let mut outer_source = sources.swap_remove(0);
-        if polys[0].signed_area() < 0.0 {
+        if exact_orientation(polys[0].points()) < 0.0 {
             polys[0] = polys[0].reversed();
             outer_source[1..].reverse();
         }
         for p in polys.iter_mut().skip(1) {
-            if p.signed_area() > 0.0 {
+            if exact_orientation(p.points()) > 0.0 {
                 *p = p.reversed();
             }
         }
@@ -348,6 +386,18 @@ fn prepare_ring(
 ) -> Result<(Vec<DVec2>, Vec<usize>, usize), GeometryError> {
     if let Some(v) = ring.iter().position(|p| !p.is_finite()) {
         return Err(GeometryError::NonFinite {
+            ring: id,
+            vertex: v,
+            x: ring[v].x,
+            y: ring[v].y,
+        });
+    }
+    let out_of_range = |c: f64| c != 0.0 && !(MIN_COORDINATE..=MAX_COORDINATE).contains(&c.abs());
+    if let Some(v) = ring
+        .iter()
+        .position(|p| out_of_range(p.x) || out_of_range(p.y))
+    {
+        return Err(GeometryError::CoordinateOutOfRange {
             ring: id,
             vertex: v,
             x: ring[v].x,

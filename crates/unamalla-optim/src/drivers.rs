@@ -197,9 +197,23 @@ pub struct SmoothReport {
     pub planarity: Option<(f64, usize)>,
     /// Wall time.
     pub elapsed: Duration,
+    /// The run ended with more non-convex cells than it started with, so [`smooth`] /
+    /// [`smooth_hex`] put the starting coordinates back (the other fields then describe the
+    /// start, except the iteration counters and the time).
+    #[serde(default)]
+    pub restored: bool,
 }
 
 impl SmoothReport {
+    /// Puts the report back to the start's convexity figures (see [`Self::restored`]).
+    fn mark_restored(&mut self) {
+        self.inocon = self.initial_inocon;
+        self.alfamin = self.initial_alfamin;
+        self.convex = self.initial_inocon == 0;
+        self.eps_convex = self.initial_alfamin > self.eps * self.alpha_bar;
+        self.restored = true;
+    }
+
     /// Total iterations over the phases.
     pub fn iterations(&self) -> usize {
         self.iter_smooth + self.iter_homotopic + self.iter_classic
@@ -295,6 +309,7 @@ fn report(
         mu: m.mu,
         planarity: None,
         elapsed: session.elapsed(),
+        restored: false,
     }
 }
 
@@ -398,6 +413,7 @@ pub fn adaptive_k(
     let mut k0: Option<f64> = None;
     let mut steps = 0;
     let mut reached = false;
+    let mut stalled = None;
     let hom_opts = SolverOptions {
         max_iter: opts.iters_per_k.max(1),
         ftol: 0.0,
@@ -435,6 +451,12 @@ pub fn adaptive_k(
             rep.continuation_steps = steps;
             return Ok(rep);
         }
+        if r.iterations == 0 {
+            // no accepted step: `x`, hence `α₋` and `k`, are unchanged, so every further
+            // update would repeat this solve exactly — the homotopy has stalled
+            stalled = Some(r.reason);
+            break;
+        }
     }
     // 2. classic phase at k*
     if opts.classic {
@@ -461,7 +483,7 @@ pub fn adaptive_k(
     rep.continuation_steps = steps;
     if !reached {
         rep.status = Status::Stopped {
-            reason: StopReason::MaxIter,
+            reason: stalled.unwrap_or(StopReason::MaxIter),
             convex: rep.convex,
         };
         rep.messages.push(rep.status);
@@ -893,9 +915,10 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
         return Err(OptimError::NoFreeNodes);
     }
     let mut x = topo.initial_x();
+    let x0 = x.clone();
     let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
     let mut session = Session::new(&probe, &x, observer);
-    let rep = match &opts.functional {
+    let mut rep = match &opts.functional {
         SmoothFunctional::BlockSmoothing {
             sigma,
             density,
@@ -926,8 +949,49 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
             omega_continuation(&topo, &mut x, &oo, &mut session)?
         }
     };
+    // never hand back more inverted cells than we were given (a run stopped early in the
+    // middle of an untangling homotopy can be worse than its start)
+    if rep.inocon > rep.initial_inocon {
+        x.copy_from_slice(&x0);
+        rep.mark_restored();
+    }
     topo.scatter(&x, mesh.nodes_mut());
     Ok(rep)
+}
+
+/// Smooths several independent meshes in parallel (rayon), each with [`smooth`] and its own
+/// fixed nodes — e.g. the blocks of a decomposition before they are merged, each with its
+/// boundary fixed (seed 000 digest §5.5: the blocks are smoothed one by one before the
+/// global smoothing of the merged mesh).
+///
+/// Meshes for which `select` returns `false` are left alone (their entry is `None`). Runs
+/// still going at `deadline` are stopped there (their status says "STOP by user"); as in
+/// [`smooth`], a run never returns more non-convex cells than its mesh had.
+pub fn smooth_each<M, S>(
+    meshes: &mut [M],
+    select: S,
+    opts: &SmoothOptions,
+    deadline: Option<std::time::Instant>,
+) -> Vec<Option<Result<SmoothReport, OptimError>>>
+where
+    M: HasQuadCells + FreeNodes + Send,
+    S: Fn(&M) -> bool + Sync,
+{
+    use crate::monitor::Control;
+    use rayon::prelude::*;
+    meshes
+        .par_iter_mut()
+        .map(|m| {
+            if !select(m) {
+                return None;
+            }
+            let mut stop_at_deadline = |_: &crate::monitor::Monitor| match deadline {
+                Some(t) if std::time::Instant::now() >= t => Control::Stop,
+                _ => Control::Continue,
+            };
+            Some(smooth(m, opts, &mut stop_at_deadline))
+        })
+        .collect()
 }
 
 /// Which hexahedral driver [`smooth_hex`] runs.
@@ -979,6 +1043,7 @@ pub fn smooth_hex<M: HasHexCells + FreeNodes + ?Sized>(
         return Err(OptimError::NoFreeNodes);
     }
     let mut x = topo.initial_x();
+    let x0 = x.clone();
     let probe = HexFunctional::h_omega(topo.clone(), 1.0, opts.scaling)?;
     let mut session = Session::new(&probe, &x, observer);
     let mut rep = omega_continuation_hex(&topo, opts.scaling, &mut x, &opts.omega, &mut session)?;
@@ -996,6 +1061,10 @@ pub fn smooth_hex<M: HasHexCells + FreeNodes + ?Sized>(
             eps_convex: b.alfamin > rep.eps * b.alpha_bar,
             ..b
         };
+    }
+    if rep.inocon > rep.initial_inocon {
+        x.copy_from_slice(&x0);
+        rep.mark_restored();
     }
     topo.scatter(&x, mesh.nodes_mut());
     Ok(rep)

@@ -64,7 +64,9 @@
 //!   Algorithm B.
 //! * [`block_smoothing`](drivers::block_smoothing): seed 000 §5.5 (6.8)/(6.9) with the
 //!   ε-convexity guarantee.
-//! * [`smooth`] / [`smooth_hex`]: the entry points used by `unamalla smooth`.
+//! * [`smooth`] / [`smooth_hex`]: the entry points used by `unamalla smooth`; they never return
+//!   more non-convex cells than they were given ([`SmoothReport::restored`]).
+//! * [`smooth_each`]: independent meshes (the blocks before merging) in parallel.
 //!
 //! ## Fixtures ([`fixtures`])
 //! The seed 001 §5 test regions (`cuad2pp`, the one-hole contour, Ivanenko's region) as TFI
@@ -82,8 +84,8 @@ pub mod solver;
 pub mod status;
 
 pub use drivers::{
-    smooth, smooth_hex, HexDriver, HexSmoothOptions, KFunctional, SmoothFunctional, SmoothOptions,
-    SmoothReport,
+    smooth, smooth_each, smooth_hex, HexDriver, HexSmoothOptions, KFunctional, SmoothFunctional,
+    SmoothOptions, SmoothReport,
 };
 pub use error::OptimError;
 pub use linalg::Preconditioner;

@@ -215,6 +215,18 @@ impl Convexity {
     }
 }
 
+/// Relative margin of the safeguard: the guard engages only when the current iterate's worst
+/// masked element exceeds the threshold by more than `GUARD_MARGIN·ᾱ`.
+///
+/// An iterate whose worst element lies within rounding of the threshold admits no step at all
+/// under the guard (every trial point, however short, flips that element's sign in the last
+/// bits, so the trust radius collapses at once); before this margin the untangling drivers
+/// could call the solver thousands of times on such an iterate without moving. With the
+/// margin the solver treats such an iterate as not yet convex; the drivers' convexity targets
+/// (`α₋ > ε·ᾱ`, ε ≥ 10⁻⁴) lie far above it, so the contract "a convex start stays convex"
+/// holds for every start that is convex by more than `10⁻⁹·ᾱ`.
+pub const GUARD_MARGIN: f64 = 1e-9;
+
 /// Per-run state shared by solvers and drivers: the observer, the monitor, the clock, the
 /// element mask (elements with a free vertex) and the domain safeguard.
 ///
@@ -347,9 +359,23 @@ impl<'o> Session<'o> {
         m
     }
 
-    /// Whether the safeguard applies at the current iterate whose masked minimum is `cur_min`.
+    /// Whether the safeguard applies at the current iterate whose masked minimum is `cur_min`:
+    /// the guard is on and `cur_min` exceeds the threshold by more than
+    /// [`GUARD_MARGIN`]`·ᾱ` (ᾱ of the last recorded iterate).
     pub fn guard_active(&self, cur_min: f64) -> bool {
-        self.guard && cur_min > self.guard_threshold
+        self.guard && cur_min > self.guard_threshold + GUARD_MARGIN * self.monitor.alpha_bar.abs()
+    }
+
+    /// Notifies the observer without counting an iteration (used when a solver run ends
+    /// without an accepted step, so that time budgets and progress displays still see the
+    /// run). Returns the observer's verdict and remembers a stop request.
+    pub fn heartbeat(&mut self) -> Control {
+        self.monitor.elapsed = self.start.elapsed();
+        let ctl = self.observer.observe(&self.monitor);
+        if ctl == Control::Stop {
+            self.stop = true;
+        }
+        ctl
     }
 
     /// `true` if `x_trial` keeps every masked element above the threshold.

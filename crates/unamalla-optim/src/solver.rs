@@ -335,6 +335,17 @@ pub fn minimize_with<P: Problem + ?Sized>(
             Solver::Pointwise => pointwise(problem, x, &mut g, opts, session, &mut st, local_guard),
         }
     };
+    // a run without an accepted step never reached the observer: let it see the run (time
+    // budgets must be able to stop drivers that call the solver repeatedly)
+    let reason = if st.iterations == 0 && reason != StopReason::User {
+        if session.heartbeat() == Control::Stop {
+            StopReason::User
+        } else {
+            reason
+        }
+    } else {
+        reason
+    };
     Ok(SolveResult {
         reason,
         iterations: st.iterations,

@@ -173,3 +173,79 @@ proptest! {
         }
     }
 }
+
+/// Number of cells of `g` with a non-positive corner triangle, counted independently of the
+/// optimizer (`unamalla_mesh::quality`).
+fn folded_cells(g: &StructuredGrid2) -> usize {
+    unamalla_mesh::quality::non_convex_cells(g).len()
+}
+
+#[test]
+fn a_run_stopped_at_any_iteration_never_returns_more_folded_cells() {
+    // Stop the untangling of the folded Ivanenko grid after 1, 2, …, 12 iterations: whatever
+    // the iterate looks like there, `smooth` hands back a mesh with at most the start's
+    // non-convex cells, the report agrees with an independent count, and a restored run
+    // hands back exactly the start.
+    let g0 = ivanenko(15, 15).unwrap();
+    let start = folded_cells(&g0);
+    assert!(start > 0);
+    for stop_after in 1..=12usize {
+        let mut g = g0.clone();
+        let mut seen = 0usize;
+        let mut stop = |_: &unamalla_optim::Monitor| {
+            seen += 1;
+            if seen >= stop_after {
+                unamalla_optim::Control::Stop
+            } else {
+                unamalla_optim::Control::Continue
+            }
+        };
+        let rep = smooth(&mut g, &opts("karea-length", Solver::TnTr), &mut stop).unwrap();
+        let now = folded_cells(&g);
+        assert!(now <= start, "stop after {stop_after}: {now} > {start}");
+        assert!(rep.inocon <= rep.initial_inocon);
+        if rep.restored {
+            assert_eq!(g.nodes(), g0.nodes());
+        }
+    }
+}
+
+#[test]
+fn smooth_each_untangles_selected_blocks_in_parallel_and_skips_the_others() {
+    let folded = ivanenko(12, 12).unwrap();
+    let good = sinusoidal(12, 12, 0.05, 1.0).unwrap();
+    let mut blocks = vec![folded.clone(), good.clone(), folded.clone()];
+    let reps = unamalla_optim::smooth_each(
+        &mut blocks,
+        |g: &StructuredGrid2| folded_cells(g) > 0,
+        &opts("ao-homega", Solver::TnTr),
+        None,
+    );
+    assert!(reps[1].is_none(), "a convex block is not selected");
+    assert_eq!(blocks[1].nodes(), good.nodes());
+    for b in [0, 2] {
+        let r = reps[b].as_ref().unwrap().as_ref().unwrap();
+        assert!(
+            r.convex && folded_cells(&blocks[b]) == 0,
+            "block {b}: {}",
+            r.status
+        );
+    }
+    // a deadline already past stops every run at its first iteration; none gets worse
+    let mut blocks = vec![folded.clone(), folded.clone()];
+    let reps = unamalla_optim::smooth_each(
+        &mut blocks,
+        |_: &StructuredGrid2| true,
+        &opts("ao-homega", Solver::TnTr),
+        Some(std::time::Instant::now()),
+    );
+    for (b, r) in blocks.iter().zip(&reps) {
+        let r = r.as_ref().unwrap().as_ref().unwrap();
+        assert!(
+            r.status.to_string().contains("STOP by user"),
+            "{}",
+            r.status
+        );
+        assert!(folded_cells(b) <= folded_cells(&folded));
+    }
+}

@@ -11,7 +11,12 @@
 //! * unstructured meshes as `DATASET UNSTRUCTURED_GRID` with `CELLS`/`CELL_TYPES`, quads of
 //!   type 9 (2D, `z = 0`) and hexahedra of type 12 (VTK vertex order, the crate family's order);
 //! * every cell array as `SCALARS <name> double 1` + `LOOKUP_TABLE default` in `CELL_DATA`
-//!   (the section is omitted when there are no arrays).
+//!   (the section is omitted when there are no arrays);
+//! * [`write_vtk_structured2_with_point_data`] and [`write_vtk_quads_with_point_data`] add
+//!   per-node arrays the same way in a `POINT_DATA` section after `CELL_DATA` (e.g. a PDE
+//!   solution `u`), checked like the cell arrays (one finite value per node,
+//!   [`IoError::PointDataLength`](crate::IoError::PointDataLength),
+//!   [`IoError::NonFinitePointValue`](crate::IoError::NonFinitePointValue)).
 //!
 //! Coordinates and values are written with the shortest representation that parses back to
 //! the same `f64` bits, so a write/read round trip is exact. Before anything is written, each
@@ -51,6 +56,7 @@ mod write;
 pub use read::{parse_vtk, read_vtk, VtkFile, VtkMesh};
 pub(crate) use write::check_cell_data;
 pub use write::{
-    write_vtk_hexes, write_vtk_quads, write_vtk_structured2, write_vtk_structured3, CellData,
+    write_vtk_hexes, write_vtk_quads, write_vtk_quads_with_point_data, write_vtk_structured2,
+    write_vtk_structured2_with_point_data, write_vtk_structured3, CellData, PointData,
     VTK_HEXAHEDRON, VTK_QUAD,
 };

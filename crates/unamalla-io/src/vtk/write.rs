@@ -24,6 +24,9 @@ pub(crate) const TITLE: &str = "written by unamalla-io";
 /// Named per-cell arrays: `(name, one value per cell)`.
 pub type CellData<'a> = [(&'a str, &'a [f64])];
 
+/// Named per-node arrays: `(name, one value per node)`.
+pub type PointData<'a> = [(&'a str, &'a [f64])];
+
 /// Writes a structured 2D grid as `DATASET STRUCTURED_GRID` with `DIMENSIONS m n 1` and `z = 0`
 /// (node order `j * m + i`, which is VTK's x-fastest order), followed by the cell arrays.
 pub fn write_vtk_structured2(
@@ -38,6 +41,53 @@ pub fn write_vtk_structured2(
         writeln!(w, "DIMENSIONS {} {} 1", grid.m(), grid.n())?;
         write_points2(w, grid.nodes())?;
         write_cell_data(w, grid.num_cells(), cell_data)
+    })
+}
+
+/// [`write_vtk_structured2`] plus per-node arrays in a `POINT_DATA` section (e.g. a PDE
+/// solution as the array `u`). Each point array must have one finite value per node and a
+/// valid name (the rules of the cell arrays; the two sections are separate name spaces).
+pub fn write_vtk_structured2_with_point_data(
+    path: impl AsRef<Path>,
+    grid: &StructuredGrid2,
+    cell_data: &CellData<'_>,
+    point_data: &PointData<'_>,
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    check_cell_data(path, grid.num_cells(), cell_data)?;
+    check_point_data(path, grid.num_nodes(), point_data)?;
+    atomic_write(path, |w| {
+        write_head(w, "STRUCTURED_GRID")?;
+        writeln!(w, "DIMENSIONS {} {} 1", grid.m(), grid.n())?;
+        write_points2(w, grid.nodes())?;
+        write_cell_data(w, grid.num_cells(), cell_data)?;
+        write_point_data(w, grid.num_nodes(), point_data)
+    })
+}
+
+/// [`write_vtk_quads`] plus per-node arrays in a `POINT_DATA` section (see
+/// [`write_vtk_structured2_with_point_data`]).
+pub fn write_vtk_quads_with_point_data<M: HasQuadCells + ?Sized>(
+    path: impl AsRef<Path>,
+    mesh: &M,
+    cell_data: &CellData<'_>,
+    point_data: &PointData<'_>,
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    let nc = mesh.num_quads();
+    check_cell_data(path, nc, cell_data)?;
+    check_point_data(path, mesh.num_nodes(), point_data)?;
+    atomic_write(path, |w| {
+        write_head(w, "UNSTRUCTURED_GRID")?;
+        write_points2(w, mesh.nodes())?;
+        writeln!(w, "CELLS {nc} {}", nc * 5)?;
+        for c in 0..nc {
+            let [a, b, cc, d] = mesh.quad(c);
+            writeln!(w, "4 {a} {b} {cc} {d}")?;
+        }
+        write_cell_types(w, nc, VTK_QUAD)?;
+        write_cell_data(w, nc, cell_data)?;
+        write_point_data(w, mesh.num_nodes(), point_data)
     })
 }
 
@@ -118,24 +168,8 @@ pub(crate) fn check_cell_data(
     num_cells: usize,
     cell_data: &CellData<'_>,
 ) -> Result<(), IoError> {
-    let mut seen = HashSet::new();
+    check_names(path, cell_data)?;
     for &(name, values) in cell_data {
-        let bad_name = |reason| IoError::InvalidArrayName {
-            path: path.to_path_buf(),
-            name: name.to_string(),
-            reason,
-        };
-        if name.is_empty() {
-            return Err(bad_name("it is empty"));
-        }
-        if !name.bytes().all(|b| b.is_ascii_graphic()) {
-            return Err(bad_name(
-                "it must be printable ASCII without whitespace (VTK legacy splits tokens on whitespace)",
-            ));
-        }
-        if !seen.insert(name) {
-            return Err(bad_name("another cell array has the same name"));
-        }
         if values.len() != num_cells {
             return Err(IoError::CellDataLength {
                 path: path.to_path_buf(),
@@ -151,6 +185,75 @@ pub(crate) fn check_cell_data(
                 cell,
                 value,
             });
+        }
+    }
+    Ok(())
+}
+
+/// Array names must be non-empty printable ASCII without whitespace and distinct.
+fn check_names(path: &Path, arrays: &[(&str, &[f64])]) -> Result<(), IoError> {
+    let mut seen = HashSet::new();
+    for &(name, _) in arrays {
+        let bad_name = |reason| IoError::InvalidArrayName {
+            path: path.to_path_buf(),
+            name: name.to_string(),
+            reason,
+        };
+        if name.is_empty() {
+            return Err(bad_name("it is empty"));
+        }
+        if !name.bytes().all(|b| b.is_ascii_graphic()) {
+            return Err(bad_name(
+                "it must be printable ASCII without whitespace (VTK legacy splits tokens on whitespace)",
+            ));
+        }
+        if !seen.insert(name) {
+            return Err(bad_name(
+                "another array of the same section has the same name",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks the point arrays: one finite value per node, valid and distinct names.
+pub(crate) fn check_point_data(
+    path: &Path,
+    num_nodes: usize,
+    point_data: &PointData<'_>,
+) -> Result<(), IoError> {
+    check_names(path, point_data)?;
+    for &(name, values) in point_data {
+        if values.len() != num_nodes {
+            return Err(IoError::PointDataLength {
+                path: path.to_path_buf(),
+                name: name.to_string(),
+                expected: num_nodes,
+                found: values.len(),
+            });
+        }
+        if let Some((node, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(IoError::NonFinitePointValue {
+                path: path.to_path_buf(),
+                name: name.to_string(),
+                node,
+                value,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn write_point_data(w: &mut dyn Write, np: usize, point_data: &PointData<'_>) -> io::Result<()> {
+    if point_data.is_empty() {
+        return Ok(());
+    }
+    writeln!(w, "POINT_DATA {np}")?;
+    for &(name, values) in point_data {
+        writeln!(w, "SCALARS {name} double 1")?;
+        writeln!(w, "LOOKUP_TABLE default")?;
+        for v in values {
+            writeln!(w, "{v:?}")?;
         }
     }
     Ok(())
@@ -202,4 +305,67 @@ fn write_cell_data(w: &mut dyn Write, nc: usize, cell_data: &CellData<'_>) -> io
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use unamalla_mesh::QuadMesh;
+
+    use super::*;
+    use crate::vtk::{read_vtk, VtkMesh};
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("unamalla-io-pd-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn point_data_round_trips_on_structured_and_quads() {
+        let g =
+            StructuredGrid2::from_fn(3, 2, |i, j| DVec2::new(i as f64, 0.5 * j as f64)).unwrap();
+        // u = x + 10 y at the nodes, in node order j·m + i
+        let u: Vec<f64> = g.nodes().iter().map(|p| p.x + 10.0 * p.y).collect();
+        let mu = [1.0, 0.5];
+        let p = tmp("s.vtk");
+        write_vtk_structured2_with_point_data(&p, &g, &[("mu", &mu)], &[("u", &u)]).unwrap();
+        let f = read_vtk(&p).unwrap();
+        assert_eq!(f.mesh, VtkMesh::Structured2(g.clone()));
+        assert_eq!(f.point_array("u"), Some(&u[..]));
+        assert_eq!(f.cell_array("mu"), Some(&mu[..]));
+        std::fs::remove_file(&p).unwrap();
+
+        let q = QuadMesh::from_grid(&g);
+        let p = tmp("q.vtk");
+        write_vtk_quads_with_point_data(&p, &q, &[], &[("u", &u)]).unwrap();
+        let f = read_vtk(&p).unwrap();
+        assert_eq!(f.point_array("u"), Some(&u[..]));
+        std::fs::remove_file(&p).unwrap();
+    }
+
+    #[test]
+    fn bad_point_data_is_rejected_before_writing() {
+        let g = StructuredGrid2::from_fn(2, 2, |i, j| DVec2::new(i as f64, j as f64)).unwrap();
+        let p = tmp("bad.vtk");
+        let e = write_vtk_structured2_with_point_data(&p, &g, &[], &[("u", &[1.0, 2.0])]);
+        assert!(matches!(
+            e,
+            Err(IoError::PointDataLength {
+                expected: 4,
+                found: 2,
+                ..
+            })
+        ));
+        let e = write_vtk_structured2_with_point_data(
+            &p,
+            &g,
+            &[],
+            &[("u", &[1.0, f64::NAN, 0.0, 0.0])],
+        );
+        assert!(matches!(
+            e,
+            Err(IoError::NonFinitePointValue { node: 1, .. })
+        ));
+        let e = write_vtk_structured2_with_point_data(&p, &g, &[], &[("a b", &[0.0; 4])]);
+        assert!(matches!(e, Err(IoError::InvalidArrayName { .. })));
+        assert!(!p.exists());
+    }
 }
