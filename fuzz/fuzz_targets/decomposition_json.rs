@@ -18,7 +18,14 @@ fn regions() -> &'static [Region; 2] {
         )
         .expect("fixed region");
         let ell = Region::new(
-            p(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]),
+            p(&[
+                (0.0, 0.0),
+                (2.0, 0.0),
+                (2.0, 1.0),
+                (1.0, 1.0),
+                (1.0, 2.0),
+                (0.0, 2.0),
+            ]),
             vec![],
         )
         .expect("fixed region");
@@ -30,6 +37,7 @@ fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
     let region = &regions()[data.len() % 2];
     if let Ok(d) = Decomposition::from_json(&text, region) {
-        d.validate(region).expect("a loaded decomposition validates");
+        d.validate(region)
+            .expect("a loaded decomposition validates");
     }
 });

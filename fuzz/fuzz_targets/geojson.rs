@@ -18,7 +18,15 @@ fuzz_target!(|data: &[u8]| {
         // the rings must be equal; `Region`'s input-index map is not compared, since the
         // written ring is already normalised (found by this target: a clockwise input maps
         // to reversed source indices, the re-read one to the identity)
-        assert_eq!(again.outer(), region.outer(), "GeoJSON round trip changed the outer ring");
-        assert_eq!(again.holes(), region.holes(), "GeoJSON round trip changed the holes");
+        assert_eq!(
+            again.outer(),
+            region.outer(),
+            "GeoJSON round trip changed the outer ring"
+        );
+        assert_eq!(
+            again.holes(),
+            region.holes(),
+            "GeoJSON round trip changed the holes"
+        );
     }
 });

@@ -65,7 +65,10 @@ fuzz_target!(|input: Input| {
         Region::new(outer, holes)
     };
     if let Ok(r) = result {
-        assert!(orientation(r.outer().points()) > 0.0, "outer ring not counter-clockwise");
+        assert!(
+            orientation(r.outer().points()) > 0.0,
+            "outer ring not counter-clockwise"
+        );
         for h in r.holes() {
             assert!(orientation(h.points()) < 0.0, "hole not clockwise");
         }

@@ -118,11 +118,12 @@ fn check_records(bytes: &[u8], path: &Path) -> Result<(), IoError> {
     let (Some(9994), Some(words)) = (be_i32(bytes, 0), be_i32(bytes, 24)) else {
         return Ok(());
     };
+    // the crate reads a record whenever its start is below the header's length, even if
+    // the record header itself extends past that length
     let declared = usize::try_from(words.max(0)).unwrap_or(0).saturating_mul(2);
-    let end = declared.min(bytes.len());
     let mut pos = 100usize;
     let mut record = 0usize;
-    while pos.saturating_add(8) <= end {
+    while pos < declared && pos.saturating_add(8) <= bytes.len() {
         let words = be_i32(bytes, pos + 4).unwrap_or(0);
         let content = match usize::try_from(words) {
             Ok(w) => w.saturating_mul(2),
@@ -149,8 +150,13 @@ fn check_records(bytes: &[u8], path: &Path) -> Result<(), IoError> {
             8 | 18 | 28 => (40i64, None, start + 36),
             _ => (0, None, 0),
         };
-        // the crate reads the shape type and the fixed fields whatever the record length says
-        if content < 4 || (fixed > 0 && (content as i64) < fixed) {
+        // the crate reads the shape type and the fixed fields whatever the record length says,
+        // and reads the next record where this one's data ended: a null shape must be exactly
+        // its 4-byte type (otherwise the crate takes its padding for the next record header)
+        if content < 4
+            || (fixed > 0 && (content as i64) < fixed)
+            || (shape_type == 0 && content != 4)
+        {
             return Err(bad(
                 pos + 4,
                 format!(

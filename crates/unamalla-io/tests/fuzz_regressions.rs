@@ -59,3 +59,39 @@ fn shapefile_record_too_short_for_its_shape_is_an_error() {
         other => panic!("expected MalformedBinary, got {other:?}"),
     }
 }
+
+/// `shapefile` target, second 10-minute run: the header declares 324 bytes; the first record
+/// ends at byte 320, and the `shapefile` crate reads a second record starting there (its start
+/// is below the declared length) whose header extends beyond it. The pre-check stopped where
+/// a whole record header no longer fitted in the declared length, so it never saw that
+/// record, whose garbage part count made the crate reserve 4 GB. The pre-check now walks
+/// exactly the records the crate reads; the second record's content length (bytes 324..328)
+/// runs past the end of the 512-byte file.
+#[test]
+fn shapefile_record_starting_below_the_declared_length_is_checked() {
+    let bytes = include_bytes!("data/fuzz/shapefile-record-across-declared-length.shp");
+    match parse_shapefile_parts(bytes) {
+        Err(IoError::MalformedBinary {
+            offset, message, ..
+        }) => {
+            assert!(offset >= 320, "offset {offset}: {message}");
+        }
+        other => panic!("expected MalformedBinary, got {other:?}"),
+    }
+}
+
+/// `shapefile` target, third 10-minute run: a null-shape record (type 0) declaring 128 bytes
+/// of content. The `shapefile` crate reads records sequentially without skipping to the
+/// declared end, so it took the padding for the next record and reserved 4 GB for a garbage
+/// multipoint count. A null shape must now have exactly its 4-byte type as content
+/// (`MalformedBinary` at the record's length field, byte 104).
+#[test]
+fn shapefile_padded_null_shape_is_an_error() {
+    let bytes = include_bytes!("data/fuzz/shapefile-padded-null-shape.shp");
+    match parse_shapefile_parts(bytes) {
+        Err(IoError::MalformedBinary {
+            offset, message, ..
+        }) => assert_eq!(offset, 104, "{message}"),
+        other => panic!("expected MalformedBinary, got {other:?}"),
+    }
+}
