@@ -4,22 +4,13 @@
 //! output file nor any temporary file in the scratch directory; an accepted case ("ok") exits
 //! 0 and writes its output. The library side is `crates/unamalla-core/tests/bad_inputs.rs`.
 
+mod common;
+use common::{bin, tmpdir};
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn catalogue_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/bad_inputs")
-}
-
-/// A fresh scratch directory per case (so "no file left" can be checked by listing it).
-fn scratch(k: usize) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "unamalla-cli-bad-inputs-{}-{k}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// A 10⁶-vertex ellipse as GeoJSON (the same ring as the core test generates).
@@ -61,7 +52,7 @@ fn run_catalogue(slow: bool) {
         if c["slow_cli"].as_bool().unwrap_or(false) != slow {
             continue;
         }
-        let out = scratch(k);
+        let out = tmpdir(&format!("case-{k}"));
         let subst = |s: &str| {
             s.replace("{out}", out.to_str().unwrap())
                 .replace("{dir}", dir.to_str().unwrap())
@@ -83,11 +74,7 @@ fn run_catalogue(slow: bool) {
             .map(|a| subst(a.as_str().unwrap()).replace("{file}", file.to_str().unwrap()))
             .collect();
         let output = c["output"].as_str().map(|o| PathBuf::from(subst(o)));
-        let r = Command::new(env!("CARGO_BIN_EXE_unamalla"))
-            .args(&args)
-            .current_dir(&out)
-            .output()
-            .unwrap();
+        let r = bin().args(&args).current_dir(&out).output().unwrap();
         ran += 1;
         let stderr = String::from_utf8_lossy(&r.stderr);
         let lines: Vec<&str> = stderr.lines().collect();

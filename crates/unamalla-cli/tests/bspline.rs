@@ -1,24 +1,10 @@
 //! `unamalla bspline`: one net on a four-sided region and one map per block, report.json
 //! fields, output files, and bad input giving one error line without output.
 
+mod common;
+use common::{bin, fixture, report, tmpdir};
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_unamalla"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/regions")
-        .join(name)
-}
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("unamalla-bspline-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
 
 /// A wavy four-sided region written as GeoJSON (clockwise on purpose: it is normalised).
 fn wavy_region(dir: &Path) -> PathBuf {
@@ -55,10 +41,6 @@ fn wavy_region(dir: &Path) -> PathBuf {
     )
     .unwrap();
     path
-}
-
-fn report(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
 }
 
 #[test]

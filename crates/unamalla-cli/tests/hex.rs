@@ -1,22 +1,8 @@
 //! End-to-end tests of `unamalla hex` (seed 004): the built-in box through Algorithms A and
 //! B, a perturbed sphere through Algorithm A, a directory of six face grids, and bad input.
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_unamalla"))
-}
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("unamalla-hex-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn report(dir: &std::path::Path) -> serde_json::Value {
-    serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()
-}
+mod common;
+use common::{bin, report, tmpdir};
 
 #[test]
 fn box_case_with_algorithm_b_has_planar_interior_faces_and_all_outputs() {

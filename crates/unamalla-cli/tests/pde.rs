@@ -1,24 +1,10 @@
 //! End-to-end tests of `unamalla pde` and `unamalla refine`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{bin, fixture, tmpdir};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_unamalla"))
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/regions")
-        .join(name)
-}
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("unamalla-pde-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
+use std::process::Output;
 
 fn ok(out: &Output) -> String {
     assert!(

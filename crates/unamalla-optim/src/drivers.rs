@@ -205,8 +205,14 @@ pub struct SmoothReport {
 }
 
 impl SmoothReport {
-    /// Puts the report back to the start's convexity figures (see [`Self::restored`]).
-    fn mark_restored(&mut self) {
+    /// If the run ended with more non-convex cells than it started with, puts the starting
+    /// coordinates `x0` back into `x` and the report back to the start's convexity figures
+    /// (see [`Self::restored`]).
+    fn keep_start_if_worse(&mut self, x: &mut [f64], x0: &[f64]) {
+        if self.inocon <= self.initial_inocon {
+            return;
+        }
+        x.copy_from_slice(x0);
         self.inocon = self.initial_inocon;
         self.alfamin = self.initial_alfamin;
         self.convex = self.initial_inocon == 0;
@@ -951,10 +957,7 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
     };
     // never hand back more inverted cells than we were given (a run stopped early in the
     // middle of an untangling homotopy can be worse than its start)
-    if rep.inocon > rep.initial_inocon {
-        x.copy_from_slice(&x0);
-        rep.mark_restored();
-    }
+    rep.keep_start_if_worse(&mut x, &x0);
     topo.scatter(&x, mesh.nodes_mut());
     Ok(rep)
 }
@@ -1062,10 +1065,7 @@ pub fn smooth_hex<M: HasHexCells + FreeNodes + ?Sized>(
             ..b
         };
     }
-    if rep.inocon > rep.initial_inocon {
-        x.copy_from_slice(&x0);
-        rep.mark_restored();
-    }
+    rep.keep_start_if_worse(&mut x, &x0);
     topo.scatter(&x, mesh.nodes_mut());
     Ok(rep)
 }

@@ -305,3 +305,29 @@ fn nan_start_is_an_error_not_a_panic() {
     let mut s = Session::new(&Rosenbrock, &[0.0, 0.0], &mut obs);
     assert!(minimize(&Rosenbrock, &mut x, &SolverOptions::default(), &mut s).is_err());
 }
+
+#[test]
+fn a_run_without_an_accepted_step_still_reaches_the_observer() {
+    // Start exactly at the minimizer: the gradient A·x* − b is exactly 0 (b was computed as
+    // A·x* by the same routine), so every solver stops before its first iteration. The
+    // observer must still see the run once (time budgets of the drivers rely on it), and a
+    // stop it asks for there is reported as a user stop.
+    let nodes = 6;
+    let xstar: Vec<f64> = (0..2 * nodes).map(|i| i as f64 * 0.5 - 1.0).collect();
+    let q = Quadratic::new(nodes, &xstar);
+    for opts in all_variants() {
+        let mut x = xstar.clone();
+        let mut calls = 0usize;
+        let mut stop = |_: &Monitor| {
+            calls += 1;
+            Control::Stop
+        };
+        let mut s = Session::new(&q, &x, &mut stop);
+        let r = minimize(&q, &mut x, &opts, &mut s).unwrap();
+        assert_eq!(r.iterations, 0);
+        assert_eq!(r.reason, StopReason::User, "{:?}", opts.solver);
+        drop(s);
+        assert_eq!(calls, 1, "{:?}", opts.solver);
+        assert_eq!(x, xstar);
+    }
+}

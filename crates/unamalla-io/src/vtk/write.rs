@@ -34,14 +34,7 @@ pub fn write_vtk_structured2(
     grid: &StructuredGrid2,
     cell_data: &CellData<'_>,
 ) -> Result<(), IoError> {
-    let path = path.as_ref();
-    check_cell_data(path, grid.num_cells(), cell_data)?;
-    atomic_write(path, |w| {
-        write_head(w, "STRUCTURED_GRID")?;
-        writeln!(w, "DIMENSIONS {} {} 1", grid.m(), grid.n())?;
-        write_points2(w, grid.nodes())?;
-        write_cell_data(w, grid.num_cells(), cell_data)
-    })
+    write_vtk_structured2_with_point_data(path, grid, cell_data, &[])
 }
 
 /// [`write_vtk_structured2`] plus per-node arrays in a `POINT_DATA` section (e.g. a PDE
@@ -116,20 +109,7 @@ pub fn write_vtk_quads<M: HasQuadCells + ?Sized>(
     mesh: &M,
     cell_data: &CellData<'_>,
 ) -> Result<(), IoError> {
-    let path = path.as_ref();
-    let nc = mesh.num_quads();
-    check_cell_data(path, nc, cell_data)?;
-    atomic_write(path, |w| {
-        write_head(w, "UNSTRUCTURED_GRID")?;
-        write_points2(w, mesh.nodes())?;
-        writeln!(w, "CELLS {nc} {}", nc * 5)?;
-        for c in 0..nc {
-            let [a, b, cc, d] = mesh.quad(c);
-            writeln!(w, "4 {a} {b} {cc} {d}")?;
-        }
-        write_cell_types(w, nc, VTK_QUAD)?;
-        write_cell_data(w, nc, cell_data)
-    })
+    write_vtk_quads_with_point_data(path, mesh, cell_data, &[])
 }
 
 /// Writes any hex mesh as `DATASET UNSTRUCTURED_GRID` with cell type 12 (VTK vertex order,
@@ -168,22 +148,67 @@ pub(crate) fn check_cell_data(
     num_cells: usize,
     cell_data: &CellData<'_>,
 ) -> Result<(), IoError> {
-    check_names(path, cell_data)?;
-    for &(name, values) in cell_data {
-        if values.len() != num_cells {
-            return Err(IoError::CellDataLength {
-                path: path.to_path_buf(),
-                name: name.to_string(),
-                expected: num_cells,
-                found: values.len(),
+    check_arrays(path, Section::Cell, num_cells, cell_data)
+}
+
+/// The two data sections of a VTK legacy file (separate name spaces).
+#[derive(Clone, Copy)]
+enum Section {
+    Cell,
+    Point,
+}
+
+impl Section {
+    fn keyword(self) -> &'static str {
+        match self {
+            Section::Cell => "CELL_DATA",
+            Section::Point => "POINT_DATA",
+        }
+    }
+}
+
+/// One finite value per cell / node, and valid, distinct names (errors name the array and the
+/// offending cell or node).
+fn check_arrays(
+    path: &Path,
+    section: Section,
+    len: usize,
+    arrays: &[(&str, &[f64])],
+) -> Result<(), IoError> {
+    check_names(path, arrays)?;
+    for &(name, values) in arrays {
+        let (path, name) = (path.to_path_buf(), name.to_string());
+        if values.len() != len {
+            let (expected, found) = (len, values.len());
+            return Err(match section {
+                Section::Cell => IoError::CellDataLength {
+                    path,
+                    name,
+                    expected,
+                    found,
+                },
+                Section::Point => IoError::PointDataLength {
+                    path,
+                    name,
+                    expected,
+                    found,
+                },
             });
         }
-        if let Some((cell, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(IoError::NonFiniteValue {
-                path: path.to_path_buf(),
-                name: name.to_string(),
-                cell,
-                value,
+        if let Some((k, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(match section {
+                Section::Cell => IoError::NonFiniteValue {
+                    path,
+                    name,
+                    cell: k,
+                    value,
+                },
+                Section::Point => IoError::NonFinitePointValue {
+                    path,
+                    name,
+                    node: k,
+                    value,
+                },
             });
         }
     }
@@ -222,41 +247,11 @@ pub(crate) fn check_point_data(
     num_nodes: usize,
     point_data: &PointData<'_>,
 ) -> Result<(), IoError> {
-    check_names(path, point_data)?;
-    for &(name, values) in point_data {
-        if values.len() != num_nodes {
-            return Err(IoError::PointDataLength {
-                path: path.to_path_buf(),
-                name: name.to_string(),
-                expected: num_nodes,
-                found: values.len(),
-            });
-        }
-        if let Some((node, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(IoError::NonFinitePointValue {
-                path: path.to_path_buf(),
-                name: name.to_string(),
-                node,
-                value,
-            });
-        }
-    }
-    Ok(())
+    check_arrays(path, Section::Point, num_nodes, point_data)
 }
 
 fn write_point_data(w: &mut dyn Write, np: usize, point_data: &PointData<'_>) -> io::Result<()> {
-    if point_data.is_empty() {
-        return Ok(());
-    }
-    writeln!(w, "POINT_DATA {np}")?;
-    for &(name, values) in point_data {
-        writeln!(w, "SCALARS {name} double 1")?;
-        writeln!(w, "LOOKUP_TABLE default")?;
-        for v in values {
-            writeln!(w, "{v:?}")?;
-        }
-    }
-    Ok(())
+    write_arrays(w, Section::Point, np, point_data)
 }
 
 fn write_head(w: &mut dyn Write, dataset: &str) -> io::Result<()> {
@@ -293,11 +288,21 @@ fn write_cell_types(w: &mut dyn Write, nc: usize, ty: u8) -> io::Result<()> {
 }
 
 fn write_cell_data(w: &mut dyn Write, nc: usize, cell_data: &CellData<'_>) -> io::Result<()> {
-    if cell_data.is_empty() {
+    write_arrays(w, Section::Cell, nc, cell_data)
+}
+
+/// A `CELL_DATA` / `POINT_DATA` section of `double` scalars (nothing when there are none).
+fn write_arrays(
+    w: &mut dyn Write,
+    section: Section,
+    len: usize,
+    arrays: &[(&str, &[f64])],
+) -> io::Result<()> {
+    if arrays.is_empty() {
         return Ok(());
     }
-    writeln!(w, "CELL_DATA {nc}")?;
-    for &(name, values) in cell_data {
+    writeln!(w, "{} {len}", section.keyword())?;
+    for &(name, values) in arrays {
         writeln!(w, "SCALARS {name} double 1")?;
         writeln!(w, "LOOKUP_TABLE default")?;
         for v in values {
