@@ -40,6 +40,7 @@ for t in "${targets[@]}"; do
         msh) cp ../tests/bad_inputs/*.msh "$seeds"/ 2>/dev/null ;;
         vtk_legacy) cp ../tests/bad_inputs/*.vtk "$seeds"/ 2>/dev/null ;;
         con) cp ../tests/bad_inputs/*.con "$seeds"/ 2>/dev/null ;;
+        shapefile) cp ../tests/bad_inputs/*.shp ../crates/unamalla-io/tests/data/pyshp/*.shp "$seeds"/ 2>/dev/null ;;
     esac
     before=$(find "artifacts/$t" -type f | wc -l)
     # The binary cargo-fuzz built, run directly (equivalent to `cargo +nightly fuzz run $t

@@ -38,7 +38,7 @@
 //! ```
 
 #![warn(missing_docs)]
-#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 // Index loops mirror the subscripts of the formulas (i, j, r, s, k, l as in the docs).
 #![allow(clippy::needless_range_loop)]
 

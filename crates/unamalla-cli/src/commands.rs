@@ -44,6 +44,7 @@ pub struct MeshArgs {
     pub boundary_density: f64,
     pub min_hole_area: Option<f64>,
     pub no_simplify: bool,
+    pub feature_factor: f64,
     pub output: PathBuf,
     pub json: bool,
     pub quiet: bool,
@@ -66,6 +67,10 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
         bail!("--boundary-density must be a number ≥ 1");
     }
     mesher = mesher.boundary_density(a.boundary_density);
+    if !(a.feature_factor.is_finite() && a.feature_factor >= 0.0) {
+        bail!("--feature-factor must be a number ≥ 0");
+    }
+    mesher = mesher.feature_factor(a.feature_factor);
     mesher = mesher.strategy(match a.strategy.as_str() {
         "submap" => Strategy::Submap,
         "auto" => Strategy::Auto,
@@ -76,18 +81,23 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);
     }
-    let simplified_for_file;
-    if a.no_simplify {
-        mesher = mesher.simplify(None);
-        simplified_for_file = region.clone();
-    } else {
-        simplified_for_file = contour::simplify_region(&region, &sopts)?.region;
-        mesher = mesher.simplify(Some(sopts));
-    }
+    mesher = mesher.simplify((!a.no_simplify).then_some(sopts));
     if let Some(f) = &a.decomposition {
         let text =
             std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
-        let d = Decomposition::from_json(&text, &simplified_for_file)?;
+        // a saved decomposition fits the region without small features; one made by hand for
+        // the simplified region (`unamalla simplify`) fits that one
+        let prepared = mesher.prepare_region(&region)?;
+        let d = match Decomposition::from_json(&text, &prepared.mesh_region) {
+            Ok(d) => d,
+            Err(e1) if prepared.simplified == prepared.mesh_region => return Err(e1.into()),
+            Err(e1) => Decomposition::from_json(&text, &prepared.simplified).map_err(|e2| {
+                anyhow::anyhow!(
+                    "{}: fits neither the meshed region ({e1}) nor the simplified region ({e2})",
+                    f.display()
+                )
+            })?,
+        };
         mesher = mesher.decomposition(d);
     }
     if !a.quiet {

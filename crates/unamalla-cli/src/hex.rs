@@ -40,6 +40,22 @@ pub struct HexArgs {
     /// Tetrahedron Jacobian scaling: parametric (default) or index.
     #[arg(long, default_value = "parametric")]
     pub scaling: String,
+    /// Algorithm B: first penalty parameter μ₀ (weight `C = 1/(2μ)`; thesis default 0.1,
+    /// its Table 4.5 also uses 176–800).
+    #[arg(long, default_value_t = 0.1)]
+    pub mu0: f64,
+    /// Algorithm B: stop the μ continuation (`μ ← 0.1μ`) once `μ ≤ mu-min` (thesis 10⁻¹²).
+    #[arg(long, default_value_t = 1e-12)]
+    pub mu_min: f64,
+    /// Algorithm B: solver iterations per μ step.
+    #[arg(long, default_value_t = 50)]
+    pub b_iters: usize,
+    /// Algorithm A: solver iterations per ω step.
+    #[arg(long, default_value_t = 100)]
+    pub a_iters: usize,
+    /// Algorithm A: ω₀ relative to the mean tetrahedron Jacobian.
+    #[arg(long, default_value_t = 0.1)]
+    pub omega0: f64,
     /// Output directory.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -79,6 +95,24 @@ pub fn run(a: HexArgs) -> Result<()> {
         "index" => HexScaling::Index,
         other => bail!("--scaling must be 'parametric' or 'index', got '{other}'"),
     };
+    for (name, v, lo) in [
+        ("--mu0", a.mu0, false),
+        ("--mu-min", a.mu_min, true),
+        ("--omega0", a.omega0, false),
+    ] {
+        if !(v.is_finite() && (v > 0.0 || (lo && v == 0.0))) {
+            bail!(
+                "{name} must be a finite number > 0{}, got {v}",
+                if lo { " (or 0)" } else { "" }
+            );
+        }
+    }
+    if a.mu_min >= a.mu0 {
+        bail!("--mu-min ({}) must be below --mu0 ({})", a.mu_min, a.mu0);
+    }
+    if a.b_iters == 0 || a.a_iters == 0 {
+        bail!("--a-iters and --b-iters must be at least 1");
+    }
     if let Some(s) = a.perturb {
         if !(s.is_finite() && s >= 0.0) {
             bail!("--perturb must be a number ≥ 0, got {s}");
@@ -116,11 +150,16 @@ pub fn run(a: HexArgs) -> Result<()> {
             a.seed
         );
     }
-    let opts = HexRunOptions {
+    let mut opts = HexRunOptions {
         algorithm,
         scaling,
         ..HexRunOptions::default()
     };
+    opts.coplanarity.mu0 = a.mu0;
+    opts.coplanarity.mu_min = a.mu_min;
+    opts.coplanarity.solver.max_iter = a.b_iters;
+    opts.omega.solver.max_iter = a.a_iters;
+    opts.omega.omega0_rel = a.omega0;
     let mut progress = ProgressObserver::new(Duration::from_millis(200));
     let observer: &mut dyn Observer = if a.quiet {
         &mut NullObserver
@@ -154,6 +193,13 @@ pub fn run(a: HexArgs) -> Result<()> {
             println!(
                 "after B: non-convex {:>5}  non-hex interior {:>5}  max|cos| {:.3e}  {} it  {:.3} s  ({})",
                 r.non_convex_cells, r.non_hex_interior_cells, r.max_abs_cos, st.iterations, st.seconds, st.status
+            );
+            println!(
+                "         μ schedule: {} steps, μ₀ {:e} → {:e} (×0.1, ≤ {} iterations each)",
+                st.continuation_steps,
+                report.options.coplanarity.mu0,
+                st.mu.unwrap_or(f64::NAN),
+                report.options.coplanarity.solver.max_iter
             );
         }
         println!(

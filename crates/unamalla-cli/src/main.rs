@@ -22,6 +22,9 @@
 //! Errors are reported as one line on stderr with a non-zero exit code; output files are
 //! written atomically, so a failed run never leaves a partial file.
 
+// Issue #14: no `unwrap`/`expect` on paths user input can reach (tests may use them).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -106,6 +109,10 @@ enum Command {
         /// Mesh the region as given, without contour simplification.
         #[arg(long)]
         no_simplify: bool,
+        /// Remove boundary features whose modified-area measure is below this many squared
+        /// target cell sizes (0 keeps every feature the simplification kept).
+        #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_FEATURE_FACTOR)]
+        feature_factor: f64,
         /// Output directory.
         #[arg(short, long)]
         output: PathBuf,
@@ -283,6 +290,7 @@ fn run(cli: Cli) -> Result<()> {
             boundary_density,
             min_hole_area,
             no_simplify,
+            feature_factor,
             output,
             json,
             quiet,
@@ -296,6 +304,7 @@ fn run(cli: Cli) -> Result<()> {
             boundary_density,
             min_hole_area,
             no_simplify,
+            feature_factor,
             output,
             json,
             quiet,

@@ -173,3 +173,59 @@ fn bad_arguments_are_one_line_errors() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
+    let dir = tmpdir("box_mu");
+    let st = bin()
+        .args([
+            "hex",
+            "box",
+            "--mu0",
+            "500",
+            "--mu-min",
+            "1e-6",
+            "--b-iters",
+            "20",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let v = report(&dir);
+    let c = &v["options"]["coplanarity"];
+    assert_eq!(c["mu0"].as_f64(), Some(500.0));
+    assert_eq!(c["mu_min"].as_f64(), Some(1e-6));
+    assert_eq!(c["solver"]["max_iter"], 20);
+    // μ = 500, 50, …, 5e-6 > 1e-6: 9 steps (the last μ is 5·10⁻⁶ up to rounding)
+    assert_eq!(v["algorithm_b"]["continuation_steps"], 9);
+    assert_eq!(v["non_hex_interior_cells"], 0);
+    std::fs::remove_dir_all(&dir).ok();
+    for bad in [
+        vec!["--mu0", "0"],
+        vec!["--mu0", "nan"],
+        vec!["--mu0", "1e-3", "--mu-min", "1e-2"],
+        vec!["--b-iters", "0"],
+    ] {
+        let dir = tmpdir("box_mu_bad");
+        let out = bin()
+            .args(["hex", "box", "--quiet", "-o"])
+            .arg(&dir)
+            .args(&bad)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{bad:?} was accepted");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--mu") || err.contains("iters"),
+            "{bad:?}: {err}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

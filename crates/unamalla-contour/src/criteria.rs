@@ -16,10 +16,33 @@
 use glam::DVec2;
 use unamalla_mesh::geometry::orient2d;
 
+/// `orient2d(a, b, c)` (the value of `robust::orient2d`, which `unamalla_mesh::geometry::orient2d`
+/// wraps), with its floating-point filter inlined: `robust` 1.2 first computes
+/// `det = (a − c)ₓ(b − c)_y − (a − c)_y(b − c)ₓ` and returns it when
+/// `|det| ≥ θ·|detleft + detright|`, θ = 3.3306690621773722e-16 (the filter of Ozaki et al.,
+/// BIT 2016, that `robust` uses); only otherwise does it run the adaptive exact stage. The same
+/// operations in the same order are repeated here, and the exact predicate is called when the
+/// filter is inconclusive, so the result is **bit-identical** to `orient2d` (checked by a
+/// property test) — the keys, and so the removal order, do not change — while the common case
+/// avoids a non-inlined cross-crate call. Sign exact, like `orient2d`.
+#[inline(always)]
+pub(crate) fn orient2d_fast(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    const THETA: f64 = 3.3306690621773722e-16;
+    let detleft = (a.x - c.x) * (b.y - c.y);
+    let detright = (a.y - c.y) * (b.x - c.x);
+    let det = detleft - detright;
+    let errbound = THETA * (detleft + detright).abs();
+    if det >= errbound || -det >= errbound {
+        det
+    } else {
+        orient2d(a, b, c)
+    }
+}
+
 /// `|α|`, the doubled (unsigned) area of triangle `abc`; exactly `0` iff collinear.
 #[inline]
 pub fn doubled_area(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    orient2d(a, b, c).abs()
+    orient2d_fast(a, b, c).abs()
 }
 
 /// Area of triangle `abc` (Visvalingam's effective area, §3.1.1).
@@ -135,5 +158,24 @@ mod tests {
         let l3 = a.distance(c);
         let expect = 2.0 * 3.0 * l3 / (5.0 + l3) * 0.5;
         assert!((modified_radius(a, b, c) - expect).abs() < 1e-12);
+    }
+
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The inlined filter returns exactly the bits of `orient2d`, also for exactly and
+        /// nearly collinear points (where the exact stage decides).
+        #[test]
+        fn fast_orientation_is_bit_identical(
+            ax in -1e3f64..1e3, ay in -1e3f64..1e3, bx in -1e3f64..1e3, by in -1e3f64..1e3,
+            t in -2.0f64..3.0, ulps in -3i64..4,
+        ) {
+            let (a, b) = (v(ax, ay), v(bx, by));
+            let p = a + t * (b - a);
+            let p = v(f64::from_bits((p.x.to_bits() as i64 + ulps) as u64), p.y);
+            for (x, y, z) in [(a, b, p), (b, p, a), (p, a, b), (a, a, p)] {
+                prop_assert_eq!(orient2d_fast(x, y, z).to_bits(), orient2d(x, y, z).to_bits());
+            }
+        }
     }
 }

@@ -27,6 +27,10 @@ pub enum ContourError {
     /// coordinates, repeated consecutive points, zero perimeter).
     #[error("degenerate ring: {0}")]
     DegenerateRing(String),
+    /// Vertex indices that do not describe a subsequence of a ring (see
+    /// [`crate::subset_hausdorff`]): empty, out of range or not strictly increasing.
+    #[error("invalid kept-vertex indices: {0}")]
+    InvalidIndices(String),
     /// The final validation of the simplified region failed. The removal and repair steps
     /// are designed so that this cannot happen; if it does, no invalid region is returned.
     #[error("the simplified region failed validation: {0}")]

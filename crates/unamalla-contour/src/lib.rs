@@ -44,8 +44,9 @@
 //! `ā`/`ᾱ` is the mean triangle **area** `(1/n) Σ |α_i|/2`. The batch criteria (areas,
 //! radii) evaluate every vertex of the current ring, delete all that satisfy the criterion, and
 //! repeat until a pass deletes nothing (Obs 3.3), recomputing `ā` each pass. The sequential
-//! methods (Visvalingam, modified areas/radii) keep the keys in a binary heap with lazy
-//! deletion and recompute only the two neighbours of a removed vertex: O(n log n). In the
+//! methods (Visvalingam, modified areas/radii) take the vertex of smallest key (ties: lowest
+//! index) from a priority queue — the initial keys sorted once plus an indexed 4-ary heap of
+//! recomputed keys — and recompute only the two neighbours of a removed vertex: O(n log n). In the
 //! modified three-step method both removal steps use `ᾱ` of the **input** ring, the "initial
 //! polygon" of (3.6). Rings are simplified separately, outer ring first, then each hole
 //! (Obs 3.3, Obs 3.5). Default thresholds: [`Method`] (table there).
@@ -54,8 +55,9 @@
 //!
 //! Beyond the thesis, no method returns a ring that self-intersects or touches another ring:
 //! a vertex `b` (neighbours `a`, `c`) is removed only if no other live vertex of **any** ring
-//! lies in the closed triangle `abc` (exact `orient2d`), queried in a bucket grid of the live
-//! vertices of all rings; a removal that fails the test is skipped (and retried in a few later
+//! lies in the closed triangle `abc` (`orient2d` with an inlined floating-point filter and the
+//! exact predicate as fallback), queried in a flat hashed bucket grid of the live vertices of
+//! all rings; a removal that fails the test is skipped (and retried in a few later
 //! rounds, when other removals may have emptied the triangle). Given valid rings the test
 //! guarantees that the new edge `ac` crosses nothing and that no ring or vertex changes side
 //! (argument in the `removal` module). After the
@@ -64,8 +66,10 @@
 //! [`unamalla_mesh::Region::new`], which validates it with exact predicates; an invalid
 //! region is never returned.
 //!
-//! Every result reports per-ring vertex counts, the relative area change and the (vertex and
-//! edge-midpoint) Hausdorff distance to the input, see [`SimplifyResult`]. Holes can be
+//! Every result reports per-ring vertex counts, the relative area change and the Hausdorff
+//! distance to the input, see [`SimplifyResult`]: for the vertex-removal methods the per-edge
+//! chain scan of [`subset_hausdorff`] (O(n), exact whenever its certificate holds, otherwise
+//! the sampled value), for the methods that move points the sampled [`hausdorff`]. Holes can be
 //! dropped below an area threshold first ([`HoleFilter`]).
 
 #![warn(missing_docs)]
@@ -86,8 +90,8 @@ pub use mpp::{minimum_perimeter_polygon, MppOptions, MppResult};
 pub use noise::{detect_noise, detect_noise_region, log_area_profile, NoiseReport};
 pub use overlay::overlay_svg;
 pub use simplify::{
-    hausdorff, remove_features_below, simplify_region, DroppedHole, HoleFilter, Method, Preset,
-    RingReport, SimplifyOptions, SimplifyResult,
+    hausdorff, remove_features_below, simplify_region, subset_hausdorff, DroppedHole, HoleFilter,
+    Method, Preset, RingReport, SimplifyOptions, SimplifyResult, SubsetHausdorff,
 };
 
 /// Absolute shoelace area of an open ring.

@@ -223,7 +223,9 @@ pub struct RingReport {
     pub after: usize,
     /// `(A_after − A_before) / A_before` of this ring's enclosed area.
     pub relative_area_change: f64,
-    /// Hausdorff distance between the input ring and the simplified ring.
+    /// Hausdorff distance between the input ring and the simplified ring: for the methods that
+    /// only remove vertices the value of [`subset_hausdorff`] (exact when its certificate holds,
+    /// which is the common case), for the methods that move points the sampled [`hausdorff`].
     pub hausdorff: f64,
 }
 
@@ -267,8 +269,9 @@ pub struct SimplifyResult {
     pub relative_area_change: f64,
     /// Largest Hausdorff distance between a kept input ring and its simplified version.
     pub hausdorff: f64,
-    /// Wall time of the simplification itself (hole filter, removal, MPP, final validation;
-    /// not the metrics).
+    /// Wall time of the simplification itself (hole filter, removal, MPP, final validation
+    /// of the output with [`Region::new`]; not the metrics, and not the validation of the
+    /// input, which the caller did when building `region`).
     pub elapsed: Duration,
 }
 
@@ -334,7 +337,7 @@ pub fn simplify_region(
     let input: Vec<Vec<DVec2>> = std::iter::once(region.outer().points().to_vec())
         .chain(kept.iter().map(|&k| region.holes()[k].points().to_vec()))
         .collect();
-    let output = run_method(&input, method, eps, delta, &opts.mpp)?;
+    let (output, kept_ids) = run_method(&input, method, eps, delta, &opts.mpp)?;
     let mut it = output.into_iter();
     let outer = it.next().unwrap_or_default();
     let simplified = Region::new(outer, it.collect())?;
@@ -346,7 +349,13 @@ pub fn simplify_region(
         .enumerate()
         .map(|(k, (s, orig))| {
             let a0 = crate::signed_area_abs(orig);
-            RingReport {
+            // vertex-removal methods: the per-edge chain scan (exact when certified, see
+            // `subset_hausdorff`); methods that move points: the sampled distance
+            let h = match kept_ids.as_ref().and_then(|ids| ids.get(k)) {
+                Some(ids) => subset_hausdorff(orig, ids)?.distance,
+                None => hausdorff(orig, s.points()),
+            };
+            Ok(RingReport {
                 ring: if k == 0 {
                     RingId::Outer
                 } else {
@@ -355,10 +364,10 @@ pub fn simplify_region(
                 before: orig.len(),
                 after: s.len(),
                 relative_area_change: (s.area() - a0) / a0,
-                hausdorff: hausdorff(orig, s.points()),
-            }
+                hausdorff: h,
+            })
         })
-        .collect();
+        .collect::<Result<_, ContourError>>()?;
     let area_before = region.area();
     let area_after = simplified.area();
     Ok(SimplifyResult {
@@ -404,14 +413,19 @@ pub fn remove_features_below(region: &Region, min_area: f64) -> Result<Region, C
     Ok(Region::new(outer, it.collect())?)
 }
 
-/// Runs one method on a valid set of rings (outer first); returns the new rings.
+/// The new rings of [`run_method`] and, for the methods that only remove vertices, the kept
+/// vertices of each ring as indices into the input ring.
+type MethodOutput = (Vec<Vec<DVec2>>, Option<Vec<Vec<usize>>>);
+
+/// Runs one method on a valid set of rings (outer first); returns the new rings (and the kept
+/// input indices when no point moved).
 fn run_method(
     input: &[Vec<DVec2>],
     method: Method,
     eps: f64,
     delta: Option<f64>,
     mpp: &MppOptions,
-) -> Result<Vec<Vec<DVec2>>, ContourError> {
+) -> Result<MethodOutput, ContourError> {
     let extract = |ws: &Workspace| -> Vec<Vec<DVec2>> {
         (0..ws.num_rings()).map(|r| ws.ring_points(r)).collect()
     };
@@ -471,7 +485,9 @@ fn run_method(
             }
         }
     }
-    Ok(extract(&ws))
+    let ids = (!method.moves_points())
+        .then(|| (0..ws.num_rings()).map(|r| ws.ring_local_ids(r)).collect());
+    Ok((extract(&ws), ids))
 }
 
 /// MPP on every ring separately, then a topology repair: vertices of edges that came to
@@ -558,6 +574,117 @@ fn conflicts(rings: &[Vec<DVec2>]) -> Vec<(usize, usize)> {
         }
     }
     out
+}
+
+/// Result of [`subset_hausdorff`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubsetHausdorff {
+    /// The Hausdorff distance (exact if `exact`, otherwise the sampled value of [`hausdorff`]).
+    pub distance: f64,
+    /// `true` if the certificate held and `distance` is the exact symmetric Hausdorff distance
+    /// between the two closed polylines (up to the rounding of one point–segment distance).
+    pub exact: bool,
+}
+
+/// Symmetric Hausdorff distance between a closed ring `input` and its simplification that
+/// keeps the vertices `kept` (strictly increasing indices into `input`, the ring order), in
+/// O(n) plus one O(m) check — the situation of every vertex-removal method.
+///
+/// Notation: `A` the input polyline (n vertices), `B` the output polyline with edges
+/// `e_k = (v_{i_k}, v_{i_{k+1}})` (m edges, cyclic), `C_k` the input chain
+/// `v_{i_k}, …, v_{i_{k+1}}` that `e_k` replaced, `d(x, S)` the Euclidean distance from a point to
+/// a set, `D = max_k max_{v ∈ C_k} d(v, e_k)` (the per-edge chain scan, O(n)).
+///
+/// 1. `h(A → B) ≤ D`: a point `x` of `A` lies on a segment of some chain `C_k`; the distance to
+///    the convex set `e_k` is convex along that segment, so `d(x, B) ≤ d(x, e_k) ≤` the larger
+///    value at the segment's end points `≤ D`.
+/// 2. `h(B → A) ≤ D`: take `x ∈ e_k` and the line `L ⟂ e_k` through `x`. The chain `C_k` runs
+///    continuously from one end point of `e_k` to the other, which lie on opposite (closed)
+///    sides of `L`, so it meets `L` at some `y`; `y − x ⟂ e_k`, hence
+///    `d(x, A) ≤ |x − y| = d(y, line(e_k))`, and the distance to a line is convex along the
+///    segment of `C_k` holding `y`, so it is at most `max_{v ∈ C_k} d(v, line(e_k)) ≤ D`.
+///    So the distance from an output edge to the input is bounded by its own chain.
+/// 3. Hence `H(A, B) = max(h(A → B), h(B → A)) ≤ D`, and `H ≥ h(A → B) ≥ d(v*, B)` for the
+///    chain vertex `v*` attaining `D`. **Certificate:** if no output edge is nearer to `v*` than
+///    its own edge (one O(m) scan), `d(v*, B) = D` and `H = D` exactly.
+///
+/// The chain bound can exceed `H` when a removed vertex is nearer to *another* output edge
+/// than to its own (a spike pointing at another part of the boundary); then the certificate
+/// fails and the sampled [`hausdorff`] (vertices and edge midpoints against exact segments,
+/// R*-tree) is returned with `exact = false`. This is the "per-edge chain" approach of issue #5;
+/// the bound `D` itself is the classical simplification error of Douglas–Peucker-type methods.
+///
+/// ```
+/// use unamalla_contour::subset_hausdorff;
+/// use unamalla_mesh::DVec2;
+/// // unit square with a bump of height 0.5 on the top side, simplified to the square
+/// let ring = [DVec2::new(0., 0.), DVec2::new(1., 0.), DVec2::new(1., 1.),
+///             DVec2::new(0.5, 1.5), DVec2::new(0., 1.)];
+/// let h = subset_hausdorff(&ring, &[0, 1, 2, 4]).unwrap();
+/// assert_eq!(h.distance, 0.5);
+/// assert!(h.exact);
+/// ```
+pub fn subset_hausdorff(input: &[DVec2], kept: &[usize]) -> Result<SubsetHausdorff, ContourError> {
+    let (n, m) = (input.len(), kept.len());
+    if m == 0 {
+        return Err(ContourError::InvalidIndices("no kept vertex".into()));
+    }
+    for (k, w) in kept.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(ContourError::InvalidIndices(format!(
+                "kept[{}] = {} does not exceed kept[{k}] = {}",
+                k + 1,
+                w[1],
+                w[0]
+            )));
+        }
+    }
+    if let Some(&last) = kept.last() {
+        if last >= n {
+            return Err(ContourError::InvalidIndices(format!(
+                "index {last} out of range for a ring of {n} vertices"
+            )));
+        }
+    }
+    // per-edge chain scan
+    let mut best = 0.0f64;
+    let mut arg: Option<usize> = None;
+    for k in 0..m {
+        let i = kept[k];
+        let j = if k + 1 < m { kept[k + 1] } else { kept[0] + n };
+        let (p, q) = (input[i], input[j % n]);
+        for t in i + 1..j {
+            let d = point_segment_distance(input[t % n], p, q);
+            if d > best {
+                best = d;
+                arg = Some(t % n);
+            }
+        }
+    }
+    let Some(star) = arg else {
+        // every removed vertex lies on its edge: A and B are the same point set
+        return Ok(SubsetHausdorff {
+            distance: 0.0,
+            exact: true,
+        });
+    };
+    // certificate: no output edge nearer to v* than D
+    let x = input[star];
+    let certified = (0..m).all(|k| {
+        let (p, q) = (input[kept[k]], input[kept[(k + 1) % m]]);
+        point_segment_distance(x, p, q) >= best
+    });
+    if certified {
+        return Ok(SubsetHausdorff {
+            distance: best,
+            exact: true,
+        });
+    }
+    let out: Vec<DVec2> = kept.iter().map(|&i| input[i]).collect();
+    Ok(SubsetHausdorff {
+        distance: hausdorff(input, &out),
+        exact: false,
+    })
 }
 
 /// Symmetric Hausdorff distance between two closed polylines, measured at the vertices and

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use proptest::prelude::*;
 use unamalla_contour::{
-    detect_noise_region, hausdorff, overlay_svg, simplify_region, ContourError, HoleFilter, Method,
-    Preset, SimplifyOptions,
+    detect_noise_region, hausdorff, overlay_svg, simplify_region, subset_hausdorff, ContourError,
+    HoleFilter, Method, Preset, SimplifyOptions,
 };
 use unamalla_mesh::geometry::{locate_in_ring, segments_intersect};
 use unamalla_mesh::{DVec2, Location, Region, RingId};
@@ -249,6 +249,121 @@ fn hausdorff_of_a_bump() {
     let bumped = [v(0., 0.), v(10., 0.), v(10., 10.), v(5., 11.), v(0., 10.)];
     assert!((hausdorff(&sq, &bumped) - 1.0).abs() < 1e-12);
     assert_eq!(hausdorff(&sq, &sq), 0.0);
+}
+
+// ---- Hausdorff distance of a vertex subset (per-edge chain scan) ----
+
+fn seg_dist(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let d = b - a;
+    let t = if d.length_squared() > 0.0 {
+        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + t * d)
+}
+
+/// Brute force directed distance from the closed polyline `from` to the closed polyline `to`:
+/// `k` + 1 evenly spaced samples per edge of `from` (vertices included) against every edge of
+/// `to`. A lower bound of the true directed distance, within half a sample spacing of it.
+fn brute_directed(from: &[DVec2], to: &[DVec2], k: usize) -> f64 {
+    let (n, m) = (from.len(), to.len());
+    let mut worst = 0.0f64;
+    for i in 0..n {
+        let (p, q) = (from[i], from[(i + 1) % n]);
+        for s in 0..=k {
+            let x = p + (s as f64 / k as f64) * (q - p);
+            let d = (0..m)
+                .map(|j| seg_dist(x, to[j], to[(j + 1) % m]))
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+        }
+    }
+    worst
+}
+
+#[test]
+fn subset_hausdorff_of_a_bump_and_of_a_spike() {
+    // bump of height 1 on the top side of a 10-square, removed: H = 1, certified (the apex is
+    // nearest to its own edge: 1 < 5 to the sides)
+    let bumped = [v(0., 0.), v(10., 0.), v(10., 10.), v(5., 11.), v(0., 10.)];
+    let h = subset_hausdorff(&bumped, &[0, 1, 2, 4]).unwrap();
+    assert_eq!((h.distance, h.exact), (1.0, true));
+    // a spike from the top side down to (5, 2), removed: its own edge is 8 away, the bottom
+    // side 2, so the certificate fails and the sampled value (a lower bound of H) is returned;
+    // H itself is at most the chain bound 8
+    let spike = [
+        v(0., 0.),
+        v(10., 0.),
+        v(10., 10.),
+        v(6., 10.),
+        v(5., 2.),
+        v(4., 10.),
+        v(0., 10.),
+    ];
+    let h = subset_hausdorff(&spike, &[0, 1, 2, 3, 5, 6]).unwrap();
+    assert!(!h.exact);
+    let out = [
+        v(0., 0.),
+        v(10., 0.),
+        v(10., 10.),
+        v(6., 10.),
+        v(4., 10.),
+        v(0., 10.),
+    ];
+    assert_eq!(h.distance, hausdorff(&spike, &out));
+    assert!(h.distance >= 2.0 && h.distance <= 8.0);
+    // nothing removed: 0; bad indices: typed errors
+    assert_eq!(
+        subset_hausdorff(&bumped, &[0, 1, 2, 3, 4])
+            .unwrap()
+            .distance,
+        0.0
+    );
+    for bad in [&[][..], &[0, 0, 2][..], &[2, 1][..], &[0, 5][..]] {
+        assert!(matches!(
+            subset_hausdorff(&bumped, bad),
+            Err(ContourError::InvalidIndices(_))
+        ));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 128, .. ProptestConfig::default() })]
+
+    /// `subset_hausdorff` against brute force on random rings and random kept subsets:
+    /// certified values equal the densely sampled distance (both directions) up to rounding;
+    /// in every case the sampled distance does not exceed the per-edge chain bound `D`
+    /// (the theorem `H ≤ D` in the function's documentation).
+    #[test]
+    fn subset_hausdorff_matches_brute_force(
+        n in 5usize..30,
+        u in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0), 30),
+        keep in prop::collection::vec(any::<bool>(), 30),
+    ) {
+        let ring = star(DVec2::ZERO, n, 3.0, 10.0, &u);
+        let kept: Vec<usize> = (0..n).filter(|&i| keep[i] || i == 0).collect();
+        prop_assume!(kept.len() >= 2);
+        let out: Vec<DVec2> = kept.iter().map(|&i| ring[i]).collect();
+        let h = subset_hausdorff(&ring, &kept).unwrap();
+        // chain bound D, computed directly
+        let m = kept.len();
+        let mut d_chain = 0.0f64;
+        for k in 0..m {
+            let (i, j) = (kept[k], if k + 1 < m { kept[k + 1] } else { kept[0] + n });
+            for t in i + 1..j {
+                d_chain = d_chain.max(seg_dist(ring[t % n], ring[i], ring[j % n]));
+            }
+        }
+        let brute = brute_directed(&ring, &out, 64).max(brute_directed(&out, &ring, 64));
+        prop_assert!(brute <= d_chain + 1e-12, "sampled {} above chain bound {}", brute, d_chain);
+        if h.exact {
+            prop_assert_eq!(h.distance, d_chain);
+            prop_assert!((h.distance - brute).abs() <= 1e-12 * (1.0 + brute), "{} vs {}", h.distance, brute);
+        } else {
+            prop_assert!(h.distance <= brute + 1e-12);
+        }
+    }
 }
 
 #[test]

@@ -29,9 +29,12 @@
 //! ```
 
 #![warn(missing_docs)]
+// user input reaches every stage: no unwrap/expect outside tests (issue #14)
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod bspline_maps;
 pub mod corners;
+pub mod flat_corners;
 pub mod hex;
 pub mod pde;
 pub mod pipeline;

@@ -2,9 +2,10 @@
 //!
 //! Stages (seed 000 digest §0.1):
 //!
-//! 1. **simplify** the contour (`unamalla-contour`, default: modified areas, thesis threshold),
+//! 1. **simplify** the contour (`unamalla-contour`, default: modified areas, thesis threshold,
+//!    halved while the area changes by more than 1 %: [`simplify_for_mesh`]),
 //!    then remove the boundary features smaller than the target cell size `h` (modified-area
-//!    measure ζ < `c·h²`, [`DEFAULT_FEATURE_FACTOR`] `c = 0.5`,
+//!    measure ζ < `c·h²`, [`DEFAULT_FEATURE_FACTOR`] `c = 5`,
 //!    [`unamalla_contour::remove_features_below`]): a block side zig-zagging at the cell scale
 //!    admits no convex cells, so such features would leave folded cells behind;
 //! 2. **decompose** into admissible blocks by cuts and choose four corners per block
@@ -17,6 +18,8 @@
 //!    once and both blocks use the same points;
 //! 5. **TFI** per block (§5.1);
 //! 6. **merge** into one conformal mesh without duplicate nodes ([`BlockMesh2::merge`]);
+//!    flat block corners on the region boundary (triangle blocks) are then bent outward by a
+//!    few degrees so their cells can be convex ([`crate::flat_corners`]);
 //! 7. **smooth** the merged mesh with `F = (1−σ)·w·F_AO + σ·H_ω` (seed 000 (6.8)/(6.9)) with the
 //!    ε-convexity guarantee of `unamalla-optim`; region boundary nodes are fixed, **cut nodes are
 //!    free**. The thesis smooths block by block and then each block with its neighbours. We
@@ -93,9 +96,17 @@ pub enum Strategy {
 }
 
 /// Default factor `c` of [`Mesher::feature_factor`]: boundary features with ζ < `c·h²` are
-/// removed (spikes and zig-zags narrower than about 0.7 cell; chord error ≈ `h/11` on smooth
-/// stretches).
-pub const DEFAULT_FEATURE_FACTOR: f64 = 0.5;
+/// removed: spikes and zig-zags narrower than about `√5·h ≈ 2.2` cells go, the chord error on
+/// smooth stretches is about `√c·h/8 ≈ 0.28·h` (see [`unamalla_contour::remove_features_below`]).
+///
+/// Chosen by measurement (`mesh_region` example on the twelve bundled regions at about 20,000
+/// cells, docs/results.md): with `c = 0.5` cell-scale coast zig-zags survived and left folded
+/// cells in the gulf of Mexico (99), Norway (31,616) and Texas; with `c = 3` and `c = 5` every
+/// real fold disappeared, and `c = 5` gave the better μ ≥ 0.8 share on most regions while the
+/// area change stayed below 2 % everywhere (largest: Norway 1.6 %). Features of size comparable
+/// to a cell cannot be represented by cells of that size anyway; ask for smaller cells
+/// (or a smaller factor) to keep them.
+pub const DEFAULT_FEATURE_FACTOR: f64 = 5.0;
 
 /// Angle tolerance (degrees) of the [`Strategy::Auto`] rule.
 pub const AUTO_ANGLE_TOLERANCE_DEG: f64 = 10.0;
@@ -141,6 +152,7 @@ pub struct Mesher {
     boundary_density: f64,
     smooth_budget: f64,
     feature_factor: f64,
+    flat_corner_deficit: f64,
     progress: Option<ProgressFn>,
     strategy: Strategy,
 }
@@ -185,6 +197,9 @@ pub struct MeshReport {
     pub non_convex_cells: usize,
     /// Interior nodes with valence ≠ 4.
     pub interior_singularities: usize,
+    /// Flat block corners on the region boundary moved outward to make their cells convex
+    /// ([`crate::flat_corners`]).
+    pub bent_corners: usize,
     /// Percentage of cells with μ ≥ 0.8.
     pub mu_ge_0_8_percent: f64,
     /// Percentages of cells with μ ≥ 0.8, 0.4 ≤ μ < 0.8, μ < 0.4.
@@ -224,6 +239,7 @@ impl Mesher {
             boundary_density: 1.0,
             smooth_budget: 20.0,
             feature_factor: DEFAULT_FEATURE_FACTOR,
+            flat_corner_deficit: crate::flat_corners::DEFAULT_MIN_DEFICIT_DEG,
             progress: None,
             strategy: Strategy::Cuts,
         }
@@ -233,6 +249,14 @@ impl Mesher {
         self.strategy = s;
         self
     }
+    /// Angle deficit (degrees) given to flat block corners on the region boundary after the
+    /// merge (default [`crate::flat_corners::DEFAULT_MIN_DEFICIT_DEG`]; 0 keeps them flat —
+    /// each then leaves one degenerate cell; see [`crate::flat_corners`]).
+    pub fn flat_corner_deficit(mut self, deg: f64) -> Self {
+        self.flat_corner_deficit = if deg.is_finite() { deg.max(0.0) } else { 0.0 };
+        self
+    }
+
     /// Boundary features whose modified-area measure ζ (seed 000 (3.4)) is below
     /// `c·h²` are removed after the contour simplification, `h` the target cell size
     /// (default [`DEFAULT_FEATURE_FACTOR`]; 0 disables; see
@@ -322,6 +346,37 @@ impl Mesher {
         }
     }
 
+    /// Pipeline steps 1 and 1b alone: the region simplified by the contour method
+    /// ([`simplify_for_mesh`]) and then without the boundary features below the cell size
+    /// ([`Mesher::feature_factor`]). The mesher meshes [`PreparedRegion::mesh_region`]; a
+    /// decomposition file must have been made for it or for [`PreparedRegion::simplified`].
+    pub fn prepare_region(&self, region: &Region) -> Result<PreparedRegion, CoreError> {
+        let (simplified, holes_dropped) = match &self.simplify {
+            Some(opts) => {
+                let r = simplify_for_mesh(region, opts)?;
+                let dropped = r.dropped_holes.iter().map(|h| h.hole).collect();
+                (r.region, dropped)
+            }
+            None => (region.clone(), Vec::new()),
+        };
+        let h = match self.size {
+            MeshSize::Cells(n) => Some((simplified.area() / n.max(1) as f64).sqrt()),
+            MeshSize::CellSize(h) => Some(h),
+            MeshSize::Density(_) => None,
+        };
+        let mesh_region = match (h, &self.simplify) {
+            (Some(h), Some(_)) if self.feature_factor > 0.0 => {
+                remove_features_below(&simplified, self.feature_factor * h * h)?
+            }
+            _ => simplified.clone(),
+        };
+        Ok(PreparedRegion {
+            simplified,
+            mesh_region,
+            holes_dropped,
+        })
+    }
+
     /// Runs the pipeline with no smoothing observer.
     pub fn mesh(self, region: &Region) -> Result<MeshResult, CoreError> {
         self.mesh_observed(region, &mut NullObserver)
@@ -341,28 +396,15 @@ impl Mesher {
             *timer = Instant::now();
         };
 
-        // 1. simplify
+        // 1. simplify, 1b. remove the features below the cell size
         self.stage(Stage::Simplify, "simplifying the contour");
-        let (simplified, holes_dropped) = match &self.simplify {
-            Some(opts) => {
-                let r = simplify_region(region, opts)?;
-                let dropped = r.dropped_holes.iter().map(|h| h.hole).collect();
-                (r.region, dropped)
-            }
-            None => (region.clone(), Vec::new()),
-        };
-        // 1b. features below the cell size (not with a decomposition file, which was made
-        // for the region as simplified by the method alone)
-        let h = match self.size {
-            MeshSize::Cells(n) => Some((simplified.area() / n.max(1) as f64).sqrt()),
-            MeshSize::CellSize(h) => Some(h),
-            MeshSize::Density(_) => None,
-        };
-        let simplified = match (h, &self.simplify, &self.decomposition) {
-            (Some(h), Some(_), None) if self.feature_factor > 0.0 => {
-                remove_features_below(&simplified, self.feature_factor * h * h)?
-            }
-            _ => simplified,
+        let prepared = self.prepare_region(region)?;
+        let holes_dropped = prepared.holes_dropped;
+        // a decomposition file fits either region: ours (saved by a previous run) fits the one
+        // without features, one made by hand for the simplified region fits the other
+        let simplified = match &self.decomposition {
+            Some(d) if d.validate(&prepared.mesh_region).is_err() => prepared.simplified,
+            _ => prepared.mesh_region,
         };
         lap(Stage::Simplify, &mut timer);
 
@@ -446,6 +488,11 @@ impl Mesher {
             }
         };
 
+        // 6b. flat block corners on the boundary (triangle blocks): bent outward so their
+        // cells can be convex
+        let bent_corners =
+            crate::flat_corners::bend_flat_corners(&mut mesh, self.flat_corner_deficit);
+
         // 7. smooth (region boundary fixed, cut nodes free)
         self.stage(Stage::Smooth, "smoothing (convexity-preserving)");
         let mut sopts = self.smooth_opts.clone();
@@ -508,6 +555,7 @@ impl Mesher {
             },
             non_convex_cells: quality.non_convex_cells,
             interior_singularities: q.map_or(0, |q| q.interior_singularities),
+            bent_corners,
             mu_ge_0_8_percent: q.map_or(0.0, |q| q.mu_bands.good),
             mu_bands: q.map_or([0.0; 3], |q| {
                 [q.mu_bands.good, q.mu_bands.fair, q.mu_bands.poor]
@@ -534,12 +582,83 @@ impl Mesher {
     }
 }
 
+/// The region after pipeline steps 1 and 1b ([`Mesher::prepare_region`]).
+#[derive(Debug, Clone)]
+pub struct PreparedRegion {
+    /// After the contour simplification ([`simplify_for_mesh`]); the input region itself
+    /// without simplification.
+    pub simplified: Region,
+    /// After the removal of boundary features below the cell size: the region that is meshed.
+    pub mesh_region: Region,
+    /// Input holes dropped by the simplification (indices in input order).
+    pub holes_dropped: Vec<usize>,
+}
+
+/// Largest relative area change (a fraction) the pipeline accepts from the contour
+/// simplification before it retries with a smaller threshold (see [`simplify_for_mesh`]).
+pub const MAX_SIMPLIFY_AREA_CHANGE: f64 = 0.01;
+
+/// The contour simplification of pipeline step 1: [`simplify_region`] with `opts`, retried with
+/// the threshold ε halved (at most six times) while the region's area changes by more than
+/// [`MAX_SIMPLIFY_AREA_CHANGE`] — unless the finer result has a vertex almost touching another
+/// edge (closer than 10⁻⁶ of the region's size), which the coarser one had removed. The thesis's default thresholds are tuned for dense, noisy
+/// contours; on a coarse silhouette of a few dozen vertices the same ε removes real shape (the
+/// bundled `horse` lost 2.1 % of its area). Use this function to reproduce the pipeline's
+/// simplified region (e.g. to validate a decomposition file against it).
+pub fn simplify_for_mesh(
+    region: &Region,
+    opts: &SimplifyOptions,
+) -> Result<unamalla_contour::SimplifyResult, CoreError> {
+    let mut r = simplify_region(region, opts)?;
+    for _ in 0..6 {
+        if r.relative_area_change.abs() <= MAX_SIMPLIFY_AREA_CHANGE {
+            break;
+        }
+        let smaller = SimplifyOptions {
+            epsilon: Some(0.5 * r.epsilon),
+            ..opts.clone()
+        };
+        let retry = simplify_region(region, &smaller)?;
+        // keep the coarser result when the finer one brings back a near contact (a vertex
+        // within 10⁻⁶ of the region's size of a non-adjacent edge): no mesh can resolve it
+        if nearly_touching(&retry.region, 1e-6) {
+            break;
+        }
+        r = retry;
+    }
+    Ok(r)
+}
+
+/// Whether some vertex of `region` lies within `rel·diag` (diag = bounding-box diagonal) of an
+/// edge of any ring other than its two own edges.
+fn nearly_touching(region: &Region, rel: f64) -> bool {
+    let (lo, hi) = region.bounding_box();
+    let tol = rel * (hi - lo).length();
+    let index = region.edge_index();
+    let rings = index.rings();
+    rings.iter().enumerate().any(|(ri, ring)| {
+        let n = ring.len();
+        ring.iter().enumerate().any(|(i, &p)| {
+            let d = DVec2::splat(tol);
+            index.candidates(p - d, p + d).any(|e| {
+                let own = e.ring == ri && (e.edge == i || (e.edge + 1) % n == i);
+                let (a, b) = index.edge(e);
+                !own && unamalla_mesh::geometry::point_segment_distance(p, a, b) <= tol
+            })
+        })
+    })
+}
+
 /// The pipeline's smoothing defaults: (6.8) with σ = 0.1 and truncated Newton (trust region)
 /// with the inner CG capped at 40 iterations — on meshes of ~20,000 cells an inexact Newton
-/// step is far cheaper than an exact one and the outer iteration still converges.
+/// step is far cheaper than an exact one and the outer iteration still converges — and at most
+/// 1000 iterations per phase.
 pub fn default_smooth_options() -> SmoothOptions {
     let mut o = SmoothOptions::default();
     o.solver.cg_max_iter = 40;
+    // the time budget ([`Mesher::smooth_budget`]) is the real limit; 200 iterations stopped
+    // the final phase early on most bundled regions
+    o.solver.max_iter = 1000;
     o
 }
 

@@ -54,6 +54,7 @@ fn variant(e: &CoreError) -> String {
             IoError::Truncated { .. } => "Io::Truncated".into(),
             IoError::Malformed { .. } => "Io::Malformed".into(),
             IoError::Mesh { .. } => "Io::Mesh".into(),
+            IoError::MalformedBinary { .. } => "Io::MalformedBinary".into(),
             other => format!("Io::other({other:?})"),
         },
         CoreError::Decompose(d) => match d {
@@ -132,6 +133,7 @@ fn run(case: &Case) -> Result<Option<Region>, CoreError> {
         "region_strict" => Ok(Some(io::read_region_geojson(f, PartSelector::Largest)?)),
         "vtk" => io::read_vtk(f).map(|_| None).map_err(Into::into),
         "msh" => io::read_msh(f).map(|_| None).map_err(Into::into),
+        "shapefile" => Ok(Some(io::read_region_shapefile(f, PartSelector::Largest)?)),
         "decomposition" => {
             let region =
                 io::read_region_geojson(case.region.as_ref().unwrap(), PartSelector::Largest)?;

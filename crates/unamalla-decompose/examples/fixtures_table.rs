@@ -6,11 +6,12 @@
 //! cargo run --release -p unamalla-decompose --example fixtures_table -- [--svg DIR] [--eps 1e-3] [--no-merge] [--only NAME]
 //! ```
 //!
-//! The regions are first simplified by a **stand-in** topology-safe scaled Visvalingam
-//! reduction written here (the contour crate is the project's simplifier; this one only keeps
-//! the example self-contained): vertices whose triangle area is below `eps · area(region)` are
-//! removed in passes, never two neighbours in one pass, never when the new edge would hit
-//! another edge or swallow a vertex of another ring.
+//! By default the regions are simplified **exactly as the default mesher does** before it
+//! decomposes (`tests/common/pipeline.rs`: the contour crate's default simplification, then the
+//! removal of boundary features below 5·h² for about 20,000 cells). With `--eps X` the older
+//! **stand-in** topology-safe scaled Visvalingam reduction is used instead (vertices whose
+//! triangle area is below `X · area(region)` are removed in passes, never two neighbours in one
+//! pass, never when the new edge would hit another edge or swallow a vertex of another ring).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -21,11 +22,14 @@ use unamalla_io::geojson::{read_region_geojson_cleaned, PartSelector};
 #[path = "../tests/common/simplify.rs"]
 mod simplify;
 use simplify::simplify;
+#[path = "../tests/common/pipeline.rs"]
+mod pipeline;
+use pipeline::pipeline_simplify;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let mut svg_dir: Option<PathBuf> = None;
-    let mut eps = 2e-4;
+    let mut eps: Option<f64> = None;
     let mut only: Option<String> = None;
     let mut merge = true;
     let mut k = 1;
@@ -36,7 +40,7 @@ fn main() {
                 k += 1;
             }
             "--eps" => {
-                eps = args.get(k + 1).and_then(|s| s.parse().ok()).unwrap_or(eps);
+                eps = args.get(k + 1).and_then(|s| s.parse().ok());
                 k += 1;
             }
             "--no-merge" => merge = false,
@@ -60,15 +64,18 @@ fn main() {
         ..DecomposeOptions::default()
     };
     let tol = Tolerances::default();
-    println!("| region | vertices (raw → simplified) | holes (handled) | blocks | triangles | cuts | admissible blocks | min corner angle / max (quad blocks) | cut joints | time |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| region | vertices (raw → simplified) | holes (handled) | blocks | triangles | cuts | admissible blocks | convex blocks | min / max corner angle (quad blocks) | corners ≥ 170° | cut joints | time |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for f in files {
         let name = f.file_stem().unwrap().to_string_lossy().to_string();
         if only.as_ref().is_some_and(|o| o != &name) {
             continue;
         }
         let (raw, _) = read_region_geojson_cleaned(&f, PartSelector::Largest).expect("region");
-        let region = simplify(&raw, eps);
+        let region = match eps {
+            Some(eps) => simplify(&raw, eps),
+            None => pipeline_simplify(&raw),
+        };
         let t0 = Instant::now();
         let res = decompose(&region, &opts);
         let dt = t0.elapsed();
@@ -78,6 +85,20 @@ fn main() {
                     .filter(|&b| d.block_admissible(b, &tol))
                     .count();
                 let tri = d.blocks.iter().filter(|b| b.triangle).count();
+                let convex = d
+                    .blocks
+                    .iter()
+                    .filter(|b| unamalla_decompose::concavity(&b.ring).approximately_convex(&tol))
+                    .count();
+                let quad_angles: Vec<f64> = d
+                    .blocks
+                    .iter()
+                    .filter(|b| !b.triangle)
+                    .flat_map(|b| b.corner_angles())
+                    .map(f64::to_degrees)
+                    .collect();
+                let straight = quad_angles.iter().filter(|a| **a >= 170.0).count();
+                let pct = |k: usize| 100.0 * k as f64 / d.blocks.len().max(1) as f64;
                 // cut endpoints off the region boundary (joints of split cuts)
                 let joints = {
                     let mut pts: Vec<(u64, u64)> = d
@@ -130,7 +151,7 @@ fn main() {
                 let back = Decomposition::from_json(&d.to_json(), &region).expect("round trip");
                 assert_eq!(back.blocks.len(), d.blocks.len());
                 println!(
-                    "| {name} | {} → {} | {} ({}) | {} | {tri} | {} | {adm}/{} | {:.1}° / {:.1}° | {joints} | {:.3} s |",
+                    "| {name} | {} → {} | {} ({}) | {} | {tri} | {} | {adm}/{} ({:.1} %) | {convex} ({:.1} %) | {:.1}° / {:.1}° | {straight} | {joints} | {:.3} s |",
                     raw.num_vertices(),
                     region.num_vertices(),
                     region.holes().len(),
@@ -138,27 +159,29 @@ fn main() {
                     d.blocks.len(),
                     d.cuts.len(),
                     d.blocks.len(),
-                    d.min_corner_angle().to_degrees(),
-                    d.blocks
-                        .iter()
-                        .filter(|b| !b.triangle)
-                        .flat_map(|b| b.corner_angles())
-                        .fold(0.0f64, f64::max)
-                        .to_degrees(),
+                    pct(adm),
+                    pct(convex),
+                    quad_angles.iter().copied().fold(f64::INFINITY, f64::min),
+                    quad_angles.iter().copied().fold(0.0f64, f64::max),
                     dt.as_secs_f64()
                 );
                 if let Some(dir) = &svg_dir {
-                    std::fs::write(
-                        dir.join(format!("decomposition-{name}.svg")),
-                        d.to_svg(&region),
+                    let svg = d.to_svg(&region);
+                    let json = d.to_json();
+                    unamalla_io::atomic_write(
+                        &dir.join(format!("decomposition-{name}.svg")),
+                        |w| w.write_all(svg.as_bytes()),
                     )
-                    .unwrap();
-                    std::fs::write(dir.join(format!("decomposition-{name}.json")), d.to_json())
-                        .unwrap();
+                    .expect("write svg");
+                    unamalla_io::atomic_write(
+                        &dir.join(format!("decomposition-{name}.json")),
+                        |w| w.write_all(json.as_bytes()),
+                    )
+                    .expect("write json");
                 }
             }
             Err(e) => println!(
-                "| {name} | {} → {} | {} | error: {e} | | | | | {:.3} s |",
+                "| {name} | {} → {} | {} | error: {e} | | | | | | | {:.3} s |",
                 raw.num_vertices(),
                 region.num_vertices(),
                 region.holes().len(),

@@ -58,6 +58,17 @@ pub struct DecomposeOptions {
     /// Distance of the points inserted by the triangle-block rule, as a fraction of the
     /// shorter incident edge (default 0.25).
     pub triangle_insert_fraction: f64,
+    /// Algorithm 4 extracts a triangle around a critical angle when its area is at least this
+    /// fraction of the region's area (default 10⁻⁵, a fifth of the mean cell area of a
+    /// 20,000-cell mesh). Smaller than `min_area_fraction` on purpose: a sharp cape or the end
+    /// of a narrow inlet is often a small piece of the region, and leaving its critical angle
+    /// in a block is worse than a small triangle block.
+    pub min_triangle_fraction: f64,
+    /// Run the corner-repair pass on blocks without four usable corners (interior angle
+    /// below `corner_weights.corner_angle_limit`): a cut splitting the block into two blocks
+    /// that have four usable corners each, or a merge with a neighbour followed by such a cut
+    /// (default `true`).
+    pub repair_corners: bool,
 }
 
 impl Default for DecomposeOptions {
@@ -65,13 +76,15 @@ impl Default for DecomposeOptions {
         Self {
             tolerances: Tolerances::default(),
             min_area_fraction: 2e-4,
-            max_blocks: 400,
+            max_blocks: 2000,
             concave_starts: 10,
             cut_weights: CutWeights::default(),
             corner_weights: CornerWeights::default(),
             critical_triangles: true,
             merge_blocks: true,
             triangle_insert_fraction: 0.25,
+            min_triangle_fraction: 1e-5,
+            repair_corners: true,
         }
     }
 }
@@ -104,7 +117,11 @@ pub(crate) struct Builder<'a> {
     pub pieces: Vec<Option<Piece>>,
     /// Cuts with an id below this were given by the user and are never merged away.
     pub protected_cuts: usize,
-    min_area: f64,
+    pub(crate) min_area: f64,
+    min_triangle: f64,
+    /// Run the corner repair in [`Builder::finish`] (off for a file that lists cuts only: those
+    /// are exactly the user's cuts).
+    pub auto_repair: bool,
 }
 
 impl<'a> Builder<'a> {
@@ -137,6 +154,8 @@ impl<'a> Builder<'a> {
             pieces: vec![Some(Piece { outer, holes })],
             protected_cuts: 0,
             min_area: opts.min_area_fraction * region.area(),
+            min_triangle: opts.min_triangle_fraction * region.area(),
+            auto_repair: true,
         }
     }
 
@@ -235,7 +254,13 @@ impl<'a> Builder<'a> {
     /// is below the tier's limit: tiers 0 and 1 use θ₋ (tier 0 also requires that a reflex start
     /// vertex is resolved: both new angles at `e1` at most 180°), tier 2 uses ½θ₋, tier 3 uses
     /// ⅕θ₋ (relaxed passes, only tried when the stricter ones find nothing).
-    fn angle_terms(&self, piece: &Piece, e1: End, e2: End, tier: usize) -> Option<(f64, f64)> {
+    pub(crate) fn angle_terms(
+        &self,
+        piece: &Piece,
+        e1: End,
+        e2: End,
+        tier: usize,
+    ) -> Option<(f64, f64)> {
         let p = piece.point(e1);
         let q = piece.point(e2);
         let (a, b) = Self::end_angles(piece, e1, q);
@@ -259,7 +284,7 @@ impl<'a> Builder<'a> {
 
     /// Feet of the perpendicular from `p` on the boundary-tagged edges of ring `r` of the piece
     /// (strictly inside the edge, away from its ends), plus the ring's vertices.
-    fn targets_on_ring(
+    pub(crate) fn targets_on_ring(
         piece: &Piece,
         r: usize,
         p: DVec2,
@@ -662,7 +687,7 @@ impl<'a> Builder<'a> {
                     pos: Pos::OnEdge(v, q),
                 };
                 let tri_area = 0.5 * (pv - p).perp_dot(q - p).abs();
-                if tri_area < self.min_area {
+                if tri_area < self.min_triangle {
                     break;
                 }
                 if piece.admissible(&idx, e1, e2) {
@@ -730,14 +755,6 @@ impl<'a> Builder<'a> {
         let tol = self.opts.tolerances;
         let mut slot: Vec<Option<Ring>> = rings.into_iter().map(Some).collect();
         let mut owner: Vec<usize> = (0..slot.len()).collect(); // union-find over slots
-        fn root(o: &mut [usize], x: usize) -> usize {
-            let mut r = x;
-            while o[r] != r {
-                r = o[r];
-            }
-            o[x] = r;
-            r
-        }
         let mut fit: Vec<f64> = slot
             .iter()
             .map(|r| r.as_ref().map_or(0.0, |r| quad_fit(&r.pts)))
@@ -832,40 +849,7 @@ impl<'a> Builder<'a> {
                 break;
             }
         }
-        // renumber cuts and blocks
-        let mut new_id = vec![usize::MAX; self.cuts.len()];
-        let mut cuts = Vec::new();
-        for (c, &alive) in alive_cut.iter().enumerate() {
-            if alive {
-                new_id[c] = cuts.len();
-                cuts.push(self.cuts[c]);
-            }
-        }
-        self.cuts = cuts;
-        let mut block_of_slot = vec![usize::MAX; slot.len()];
-        let mut out = Vec::new();
-        for (k, r) in slot.into_iter().enumerate() {
-            if let Some(mut r) = r {
-                for t in &mut r.tags {
-                    if let Tag::Cut(c) = t {
-                        *c = new_id[*c];
-                    }
-                }
-                block_of_slot[k] = out.len();
-                out.push(r);
-            }
-        }
-        for node in &mut self.nodes {
-            node.cuts.retain(|c| new_id[*c] != usize::MAX);
-            for c in &mut node.cuts {
-                *c = new_id[*c];
-            }
-            if let Some(b) = node.block {
-                let r = root(&mut owner, b);
-                node.block = Some(block_of_slot[r]);
-            }
-        }
-        out
+        self.renumber(slot, owner, alive_cut)
     }
 
     /// Turns the leaves into blocks, resolves neighbours, applies the triangle rule, selects
@@ -925,6 +909,11 @@ impl<'a> Builder<'a> {
         }
         let rings = if self.opts.merge_blocks {
             self.merge_pass(rings)
+        } else {
+            rings
+        };
+        let rings = if self.opts.repair_corners && self.auto_repair {
+            self.repair_pass(rings)
         } else {
             rings
         };
@@ -1036,9 +1025,12 @@ impl<'a> Builder<'a> {
                     ([c[0], c[1], c[2], c[3]], true)
                 }
                 None => match select_corners(&r.pts, &self.opts.corner_weights).or_else(|| {
-                    // fallback: any four non-reflex vertices, however straight
+                    // last resort (counted as "corners ≥ 170°" in docs/results.md): any four
+                    // non-reflex vertices, however straight; only reached when neither the
+                    // corner repair nor the triangle rule could serve the block
                     let w = CornerWeights {
                         max_corner_angle: PI,
+                        corner_angle_limit: PI,
                         ..self.opts.corner_weights
                     };
                     select_corners(&r.pts, &w)
@@ -1076,7 +1068,7 @@ fn is_triangle_like(ring: &[DVec2], w: &CornerWeights) -> bool {
     let n = ring.len();
     n == 3
         || (0..n)
-            .filter(|&i| ring_angle(ring, i) < w.max_corner_angle)
+            .filter(|&i| ring_angle(ring, i) < w.corner_angle_limit)
             .count()
             < 4
 }
@@ -1095,7 +1087,7 @@ pub(crate) fn choose_corners(
 ) -> Result<CornerChoice, DecomposeError> {
     let n = ring.len();
     let strong = (0..n)
-        .filter(|&i| ring_angle(ring, i) < opts.corner_weights.max_corner_angle)
+        .filter(|&i| ring_angle(ring, i) < opts.corner_weights.corner_angle_limit)
         .count();
     if n == 3 || strong < 4 {
         let can = |e: usize| matches!(edges[e], EdgeKind::Boundary { .. });

@@ -1,8 +1,15 @@
 //! Corner selection (seed 000 digest §4.2, thesis §5.1.1) and the triangle-block rule.
 //!
 //! **Quadrilateral blocks.** Candidates are vertices with interior angle θ < θ_max (default
-//! 165°: neither reflex nor nearly collinear); when fewer than four qualify, every non-reflex
-//! vertex is a candidate. Among the best `M` candidates (ranked by the angle penalty g(θ)), every
+//! 165°: neither reflex nor nearly collinear); when fewer than four qualify, every vertex with
+//! θ < θ_lim (default **170°**, the hard bound) is a candidate. A vertex with θ ≥ θ_lim is
+//! **never** a corner: at such a corner the two block sides leave in (nearly) opposite
+//! directions, so the corner cell of any structured grid has a (nearly) straight angle there —
+//! with fixed boundary nodes its corner triangle has α ≈ 0 and no smoothing can repair it.
+//! Blocks without four such vertices get no corners here; the decomposition repairs them with
+//! an extra cut (module `auto`). The 170° bound is ours (the thesis only says "not collinear",
+//! seed 000 digest §4.2); 165°–170° corners still give cells with a 165°–170° angle, which the
+//! smoother can only improve by moving interior nodes. Among the best `M` candidates (ranked by the angle penalty g(θ)), every
 //! cyclically ordered 4-tuple c₀ < c₁ < c₂ < c₃ is scored by
 //!
 //! ```text
@@ -38,6 +45,8 @@ pub struct CornerWeights {
     pub turn: f64,
     /// θ_max: vertices with a larger interior angle are not preferred as corners.
     pub max_corner_angle: f64,
+    /// θ_lim: vertices with this interior angle or more are never corners (default 170°).
+    pub corner_angle_limit: f64,
     /// M: how many candidates enter the exhaustive 4-tuple search.
     pub candidates: usize,
 }
@@ -48,22 +57,25 @@ impl Default for CornerWeights {
             balance: 0.5,
             turn: 1.0,
             max_corner_angle: 165f64.to_radians(),
+            corner_angle_limit: 170f64.to_radians(),
             candidates: 18,
         }
     }
 }
 
 /// The best corner 4-tuple of a ring and its score F (lower is better), or `None` when the
-/// ring has fewer than four non-reflex vertices.
+/// ring has fewer than four vertices with an interior angle below `w.corner_angle_limit`.
 pub fn select_corners(ring: &[DVec2], w: &CornerWeights) -> Option<([usize; 4], f64)> {
     let n = ring.len();
     if n < 4 {
         return None;
     }
     let angles: Vec<f64> = (0..n).map(|i| ring_angle(ring, i)).collect();
-    let mut cands: Vec<usize> = (0..n).filter(|&i| angles[i] < w.max_corner_angle).collect();
+    let preferred = w.max_corner_angle.min(w.corner_angle_limit);
+    let mut cands: Vec<usize> = (0..n).filter(|&i| angles[i] < preferred).collect();
     if cands.len() < 4 {
-        cands = (0..n).filter(|&i| angles[i] < PI).collect();
+        let limit = w.corner_angle_limit.min(PI);
+        cands = (0..n).filter(|&i| angles[i] < limit).collect();
     }
     if cands.len() < 4 {
         return None;
@@ -336,6 +348,36 @@ mod tests {
         let (c, f) = select_corners(&ring, &CornerWeights::default()).unwrap();
         assert_eq!(c, [0, 2, 3, 5]);
         assert!(f.abs() < 1e-12);
+    }
+
+    /// y-offset that gives a 178° vertex at (2, −h) between (0,0) and (4,0):
+    /// the two edges turn by atan(h/2) each, so the interior angle is 180° − 2·atan(h/2) = 178°.
+    fn h178() -> f64 {
+        2.0 * 1f64.to_radians().tan()
+    }
+
+    #[test]
+    fn a_178_degree_vertex_is_never_a_corner() {
+        let h = h178();
+        // triangle-like: apex 2,3 and a 178° vertex on the base: only three usable corners
+        let tri = vec![v(0., 0.), v(2., -h), v(4., 0.), v(2., 3.)];
+        assert!((ring_angle(&tri, 1).to_degrees() - 178.0).abs() < 1e-9);
+        assert_eq!(select_corners(&tri, &CornerWeights::default()), None);
+        // even when θ_max would admit it, the hard limit θ_lim = 170° does not
+        let loose = CornerWeights {
+            max_corner_angle: PI,
+            ..CornerWeights::default()
+        };
+        assert_eq!(select_corners(&tri, &loose), None);
+        // with a fourth usable vertex the straight one is skipped
+        let rect = vec![v(0., 0.), v(2., -h), v(4., 0.), v(4., 2.), v(0., 2.)];
+        let (c, _) = select_corners(&rect, &CornerWeights::default()).unwrap();
+        assert_eq!(c, [0, 2, 3, 4]);
+        // and a 169° vertex is still usable when it is needed (three 60°-ish corners)
+        let h169 = 2.0 * 5.5f64.to_radians().tan();
+        let tri2 = vec![v(0., 0.), v(2., -h169), v(4., 0.), v(2., 3.)];
+        let (c, _) = select_corners(&tri2, &CornerWeights::default()).unwrap();
+        assert_eq!(c, [0, 1, 2, 3]);
     }
 
     #[test]

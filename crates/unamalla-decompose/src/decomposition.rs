@@ -72,6 +72,9 @@ pub enum Step {
     CriticalAngle,
     /// A cut given in a decomposition file.
     User,
+    /// A cut added by the corner repair (a block without four usable corners, module
+    /// `repair`; beyond the thesis).
+    CornerRepair,
 }
 
 /// A node of the binary decomposition tree T (seed 000 digest §3.3).

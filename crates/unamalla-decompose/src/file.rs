@@ -379,6 +379,7 @@ fn load_cuts(
         }
     }
     b.protected_cuts = b.cuts.len();
+    b.auto_repair = complete;
     if complete {
         let leaves: Vec<usize> = (0..b.nodes.len())
             .filter(|&n| b.pieces[n].is_some())

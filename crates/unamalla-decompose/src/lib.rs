@@ -75,9 +75,10 @@
 //! 3. **more than three sides and a critical angle (< θ₋ = 40°) → Algorithm 4**: a triangle
 //!    p v q with p, q on the two edges at v at the same distance d = ½·min(edge lengths) (halved
 //!    up to four times until pq is a valid cut) is cut off and left as a leaf; the triangle
-//!    angles are θ and (180° − θ)/2, the remainder gets 90° + θ/2 at p and q. A triangle
-//!    smaller than the negligible area is not extracted (the critical corner stays; such blocks
-//!    are reported as not admissible by [`Decomposition::block_admissible`]).
+//!    angles are θ and (180° − θ)/2, the remainder gets 90° + θ/2 at p and q. The triangle must
+//!    have at least `min_triangle_fraction` (10⁻⁵) of the region's area — smaller than the
+//!    negligible area on purpose (issue #6: a critical corner left in a block is worse than a
+//!    small triangle block; the thesis's Obs 4.5 only warns against small triangles).
 //!
 //! **Validity rules** (§4.2.3): cuts are disjoint (they never cross piece boundaries and end only
 //! at vertices or inside original-boundary edges, never inside another cut); no new angle at a
@@ -99,6 +100,14 @@
 //! merged away. The tree T keeps the split history; its leaves point to the block containing
 //! them.
 //!
+//! **Corner repair** (beyond the thesis, module `repair`): after the merge pass, a block with
+//! fewer than four *usable* corners (interior angle < 170°), a critical angle or a non-convex
+//! shape is split by one more cut into two good blocks, or merged with a neighbour (and the
+//! union re-split), so that the shared cut meets the boundary at a better angle. Note the
+//! counting bound behind it: a straight cut adds at most two usable corners at each end, and one
+//! block, so a region (or a union of blocks) with fewer than four usable vertices can never be
+//! cut into blocks with four usable corners each — a triangle stays a triangle block.
+//!
 //! **Triangle-block rule and split cuts.** Blocks with three vertices or fewer than four
 //! corner-like vertices get the triangle-block rule, inserting on original boundary edges only
 //! when possible; otherwise a block with four non-reflex vertices takes its corners among them
@@ -109,10 +118,11 @@
 //! is an interior mesh node of valence 3 (a singularity) — it does not occur in the fixture
 //! decompositions of `docs/results.md (section "Decomposition results")` unless the table says so.
 //!
-//! **Corners** ([`corners`], seed 000 digest §4.2): the best 4-tuple of non-reflex,
-//! non-collinear vertices by `F = ¼Σg(θ) + w_bal·balance + w_turn·straightness`; triangles get
+//! **Corners** ([`corners`], seed 000 digest §4.2): the best 4-tuple of vertices with an
+//! interior angle below 170° (never a straight or reflex vertex) by `F = ¼Σg(θ) + w_bal·balance + w_turn·straightness`; triangles get
 //! the triangle-block rule (two points inserted near each critical vertex, on its two edges,
-//! at the same distance).
+//! at the same distance). Those inserted corners have 180° by construction (the thesis's rule,
+//! Figs 5.3–5.4); they are the only corners at or above 170°.
 //!
 //! ## Submapping (seed 002)
 //!
@@ -131,6 +141,7 @@
 //! [`Decomposition::to_svg`] draws blocks, cuts, corners and ids.
 
 #![warn(missing_docs)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod auto;
 pub mod concavity;
@@ -141,6 +152,7 @@ pub mod file;
 mod geom;
 mod piece;
 mod render;
+mod repair;
 pub mod submap;
 
 pub use auto::{decompose, CutWeights, DecomposeOptions};

@@ -101,6 +101,17 @@ fn bench_2d(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("hessian", cells), &cells, |b, _| {
             b.iter(|| f.hessian(&x, &mut h))
         });
+        // the two ways of a Hessian-vector product for CG: matrix-free and CSR SpMV
+        let v = grad.clone();
+        let mut out = vec![0.0; f.num_vars()];
+        group.bench_with_input(
+            BenchmarkId::new("hess_vec_matrix_free", cells),
+            &cells,
+            |b, _| b.iter(|| f.hess_vec(&x, &v, &mut out)),
+        );
+        group.bench_with_input(BenchmarkId::new("csr_mul_vec", cells), &cells, |b, _| {
+            b.iter(|| h.mul_vec(&v, &mut out))
+        });
     }
     group.finish();
 }

@@ -1,6 +1,17 @@
-//! Quick wall-clock timing of value + gradient of `0.9·F_AO + 0.1·H_ω` on an `n × n`-cell grid
-//! (default 1000, repeated `reps` times, default 10): `cargo run --release --example time_eval -- 1000 10`. Use `RAYON_NUM_THREADS=1`
-//! for one core. The criterion benchmarks in `benches/` are the reference numbers.
+//! Timing of `0.9·F_AO + 0.1·H_ω` (seed 000 (6.8), σ = 0.1, ω = ᾱ/2) on an `n × n`-cell grid:
+//! value + gradient, Hessian refresh, matrix-free Hessian-vector product and CSR SpMV, for the
+//! typed kernel (`Sum<AreaOrthogonality, HOmega>`) and the run-time `Kernel2` combination, plus
+//! the reference (per-triangle) path for comparison.
+//!
+//! ```text
+//! cargo run --release -p unamalla-functionals --example time_eval -- [cells=1000] [reps=10]
+//! RAYON_NUM_THREADS=1 .../time_eval 1000 21     # one core
+//! ```
+//!
+//! For every operation it prints the best wall time and the best **CPU time** of one call (CPU
+//! time of the whole process, read from `/proc/self/task/*/schedstat` in nanoseconds, so it is
+//! meaningful on a loaded machine where wall time is not). The criterion benchmarks in
+//! `benches/` give the statistics.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -8,11 +19,34 @@ use std::time::Instant;
 use unamalla_functionals::*;
 use unamalla_mesh::{DVec2, StructuredGrid2};
 
+/// CPU time of all threads of this process in nanoseconds (Linux; 0 elsewhere).
+fn cpu_ns() -> u64 {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
+        return 0;
+    };
+    dir.filter_map(|e| e.ok())
+        .filter_map(|e| std::fs::read_to_string(e.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .sum()
+}
+
+/// Best wall and best CPU milliseconds of `reps` calls of `f`.
+fn time(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
+    let (mut wall, mut cpu) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..reps {
+        let c0 = cpu_ns();
+        let t = Instant::now();
+        f();
+        wall = wall.min(t.elapsed().as_secs_f64() * 1e3);
+        cpu = cpu.min((cpu_ns() - c0) as f64 * 1e-6);
+    }
+    (wall, cpu)
+}
+
 fn main() {
-    let cells: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1000);
+    let mut args = std::env::args().skip(1);
+    let cells: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1000);
+    let reps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(10);
     let m = cells + 1;
     let h = 1.0 / cells as f64;
     let g = StructuredGrid2::from_fn(m, m, |i, j| {
@@ -31,33 +65,63 @@ fn main() {
     .expect("valid grid");
     let topo = Arc::new(QuadTopology::from_mesh(&g).expect("valid mesh"));
     let abar = topo.alpha_bar();
+    let homega = HOmega::new(0.5 * abar).expect("ω > 0");
     let f = QuadFunctional::new(
         topo.clone(),
-        Sum::convex(
-            0.9,
-            AreaOrthogonality,
-            HOmega::new(0.5 * abar).expect("ω > 0"),
-        )
-        .expect("σ"),
+        Sum::convex(0.9, AreaOrthogonality, homega).expect("σ"),
+    );
+    let fd = QuadFunctional::new(
+        topo.clone(),
+        Kernel2::convex(0.9, Kernel2::AreaOrthogonality, Kernel2::HOmega(homega)).expect("σ"),
     );
     let x = topo.initial_x();
-    let mut grad = vec![0.0; f.num_vars()];
-    let mut best = f64::INFINITY;
-    let mut v = 0.0;
-    let reps: usize = std::env::args()
-        .nth(2)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(10);
-    for _ in 0..reps {
-        let t = Instant::now();
-        v = f.value_grad(&x, &mut grad);
-        best = best.min(t.elapsed().as_secs_f64());
-    }
+    let n = f.num_vars();
+    let mut grad = vec![0.0; n];
+    let mut out = vec![0.0; n];
+    let tri = topo.num_triangles() as f64;
+    let threads = rayon::current_num_threads();
     println!(
-        "{cells}x{cells} cells, {} triangles, {} colours: value_grad best of {reps} = {:.2} ms ({:.1} M triangles/s), value = {v}",
+        "{cells}x{cells} cells, {} triangles, {} colours, {threads} rayon thread(s), best of {reps}:",
         topo.num_triangles(),
         topo.num_colors(),
-        best * 1e3,
-        topo.num_triangles() as f64 / best / 1e6
     );
+    let report = |name: &str, (wall, cpu): (f64, f64)| {
+        println!(
+            "  {name:<28} wall {wall:8.2} ms  cpu {cpu:8.2} ms  ({:.1} M triangles/s wall)",
+            tri / wall / 1e3
+        );
+    };
+    let mut v = 0.0;
+    report(
+        "value_grad (typed)",
+        time(reps, || v = f.value_grad(&x, &mut grad)),
+    );
+    report(
+        "value_grad (Kernel2)",
+        time(reps, || v = fd.value_grad(&x, &mut grad)),
+    );
+    report(
+        "value_grad (reference)",
+        time(reps.min(5), || v = f.value_grad_reference(&x, &mut grad)),
+    );
+    report("value (typed)", time(reps, || v = f.value(&x)));
+    let mut hm = f.hessian_pattern();
+    report(
+        "hessian refresh (typed)",
+        time(reps, || f.hessian(&x, &mut hm)),
+    );
+    report(
+        "hessian refresh (Kernel2)",
+        time(reps, || fd.hessian(&x, &mut hm)),
+    );
+    report(
+        "hessian refresh (reference)",
+        time(reps.min(3), || f.hessian_reference(&x, &mut hm)),
+    );
+    report(
+        "hess_vec matrix-free",
+        time(reps, || f.hess_vec(&x, &grad, &mut out)),
+    );
+    report("CSR mul_vec", time(reps, || hm.mul_vec(&grad, &mut out)));
+    println!("  value = {v}, Hessian nnz = {}", hm.nnz());
 }

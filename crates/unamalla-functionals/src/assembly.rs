@@ -48,6 +48,16 @@ impl SyncPtr {
     pub(crate) unsafe fn add(self, i: usize, v: f64) {
         *self.0.add(i) += v;
     }
+    /// Stores `v` at index `i` if `first`, adds it otherwise (the first contribution of the
+    /// deterministic schedule overwrites, so the buffer needs no zeroing pass).
+    ///
+    /// # Safety
+    /// As for [`add`](Self::add).
+    #[inline(always)]
+    pub(crate) unsafe fn put(self, i: usize, v: f64, first: bool) {
+        let p = self.0.add(i);
+        *p = if first { v } else { *p + v };
+    }
 }
 
 /// Connectivity of a mesh whose cells have `K` nodes, with free/fixed flags.
@@ -324,7 +334,89 @@ impl<const K: usize> Assembly<K> {
         guard.iter().sum()
     }
 
+    /// Like [`run_colored`](Self::run_colored) with one call per chunk: `per_chunk(start, end)`
+    /// processes cells `start..end` in order and returns their sum (accumulated from 0.0 in
+    /// cell order, so the result equals the per-cell form bit for bit).
+    pub(crate) fn run_colored_chunks<F>(&self, per_chunk: F) -> f64
+    where
+        F: Fn(usize, usize) -> f64 + Sync,
+    {
+        let mut guard = match self.scratch.lock() {
+            Ok(g) => g,
+            Err(p) => p.into_inner(),
+        };
+        let ncells = self.cells.len();
+        let sums = SyncPtr::new(&mut guard);
+        for color in &self.colors {
+            color.par_iter().with_max_len(1).for_each(|&ch| {
+                let ch = ch as usize;
+                let start = ch * CHUNK_CELLS;
+                let end = (start + CHUNK_CELLS).min(ncells);
+                let s = per_chunk(start, end);
+                // SAFETY: chunk `ch` is processed exactly once; index < num_chunks.
+                unsafe {
+                    let p = sums;
+                    *p.0.add(ch) = s;
+                }
+            });
+        }
+        guard.iter().sum()
+    }
+
+    /// Value-only parallel sum with one call per chunk (see
+    /// [`run_colored_chunks`](Self::run_colored_chunks)); chunk sums combined in chunk order.
+    pub(crate) fn run_value_chunks<F>(&self, per_chunk: F) -> f64
+    where
+        F: Fn(usize, usize) -> f64 + Sync,
+    {
+        let mut guard = match self.scratch.lock() {
+            Ok(g) => g,
+            Err(p) => p.into_inner(),
+        };
+        let ncells = self.cells.len();
+        guard
+            .par_iter_mut()
+            .with_max_len(1)
+            .enumerate()
+            .for_each(|(ch, out)| {
+                let start = ch * CHUNK_CELLS;
+                let end = (start + CHUNK_CELLS).min(ncells);
+                *out = per_chunk(start, end);
+            });
+        guard.iter().sum()
+    }
+
+    /// Serial form of [`run_value_chunks`](Self::run_value_chunks) (same sums, same order).
+    pub(crate) fn run_serial_chunks<F>(&self, per_chunk: F) -> f64
+    where
+        F: Fn(usize, usize) -> f64,
+    {
+        let ncells = self.cells.len();
+        let mut total = 0.0;
+        for ch in 0..self.num_chunks {
+            let start = ch * CHUNK_CELLS;
+            let end = (start + CHUNK_CELLS).min(ncells);
+            total += per_chunk(start, end);
+        }
+        total
+    }
+
+    /// The cells in the order of the deterministic schedule of
+    /// [`run_colored`](Self::run_colored) (colour by colour, chunks of a colour in list order,
+    /// cells of a chunk in order). Chunks of one colour share no node, so for every node the
+    /// order of its contributions is the order of this sequence whatever the thread count.
+    pub(crate) fn schedule(&self) -> impl Iterator<Item = usize> + '_ {
+        let ncells = self.cells.len();
+        self.colors.iter().flat_map(move |color| {
+            color.iter().flat_map(move |&ch| {
+                let start = ch as usize * CHUNK_CELLS;
+                start..(start + CHUNK_CELLS).min(ncells)
+            })
+        })
+    }
+
     /// Runs `per_cell` over all cells, sequentially in cell order, summing the results.
+    #[allow(dead_code)] // the serial per-cell form of `run_colored`, for evaluators without chunks
     pub(crate) fn run_serial_sum<F>(&self, per_cell: F) -> f64
     where
         F: Fn(usize) -> f64 + Sync,

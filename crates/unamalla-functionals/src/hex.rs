@@ -25,6 +25,17 @@
 //! `s = Σ‖c‖²`, `∂²λ = rI + ccᵀ/(3r)`; `∂V/∂c₁ = c₂×c₃` (cyclic), `∂²V/∂c_a∂c_b = ε_{abc}M(c_c)`
 //! with `M(w)_{ij} = ε_{ijk}w_k`; chained to the vertices through the stencils.
 //!
+//! # Node-block Hessian (issue #10)
+//! With the stencil column `w_j = (w_0j, w_1j, w_2j)` of vertex `j`, `α_j = Σ_a w_aj c_a`,
+//! `β_j = Σ_a w_aj ∂V/∂c_a` and `G_jl = w_j·w_l`, the chain rule
+//! `H_jl = Σ_ab w_aj w_bl ∂²f/∂c_a∂c_b` collapses (using `Σ_ab w_aj w_bl ε_abc = (w_j × w_l)_c`) to
+//! `H_jl = wt·[φ(r G_jl I + α_j α_lᵀ/(3r)) + φ'r(α_j β_lᵀ + β_j α_lᵀ) + λφ''β_j β_lᵀ
+//! + λφ'M(Σ_c (w_j × w_l)_c c_c)]`: ten closed-form 3×3 blocks per tetrahedron (the other six
+//! by symmetry) instead of spreading the 9 column blocks over up to 16 vertex pairs. The
+//! blocks of a cell are summed as 8×8 node blocks and added at CSR positions computed once
+//! with the pattern ([`HexTopology::block_slots`]). The face terms use the same form (legs
+//! `B−A, D−A, C−A`). The previous assembly is kept as [`HexFunctional::hessian_reference`].
+//!
 //! # Coplanarity (seed 004 §4.1 criterion 2, (4.2)–(4.4))
 //! For a face `ABCD`: `N = AB × AD`, `k = N·AC/(‖N‖‖AC‖)` (a signed cosine; `k² = |cos|²`). The
 //! penalty is `C·Σ_cells Σ_faces k²` over the six faces (1234), (5678), (1265), (4378), (1485),
@@ -36,7 +47,7 @@
 //! `k² = t²/(n₂w₂)` with `t = det[AB, AD, AC]`, `n₂ = ‖AB × AD‖²`, `w₂ = ‖AC‖²` are exact
 //! (polynomial parts differentiated by hand). A face with `n₂w₂ = 0` contributes 0.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -208,6 +219,9 @@ pub struct HexTopology {
     asm: Assembly<8>,
     base: Vec<DVec3>,
     interior: Vec<bool>,
+    /// Per cell, the CSR position of the first entry of each 3×3 node block (see
+    /// [`HexTopology::block_slots`]); built on the first Hessian assembly.
+    slots: OnceLock<Option<Vec<[u32; 64]>>>,
 }
 
 impl HexTopology {
@@ -254,6 +268,7 @@ impl HexTopology {
             asm,
             base: nodes,
             interior,
+            slots: OnceLock::new(),
         })
     }
 
@@ -340,6 +355,56 @@ impl HexTopology {
         Csr::from_block_pattern(3, &self.asm.nbr_offsets, &self.asm.nbr)
     }
 
+    /// The CSR slot table of the node-block Hessian assembly, computed once with the pattern:
+    /// entry `8a + b` of cell `c` is the position in [`Csr::values`] of the `(0, 0)` entry of the
+    /// 3×3 block (local vertex `a`, local vertex `b`) of a matrix built by
+    /// [`HexTopology::hessian_pattern`], or `u32::MAX` when `a` or `b` is a fixed node. Row `r`
+    /// of the block starts `r·3·deg(a)` entries further (the rows of one node block-row have
+    /// equal length `3·deg`). `None` if the Hessian has more than `u32::MAX` entries (then the
+    /// per-entry search of the reference assembly is used).
+    pub fn block_slots(&self) -> Option<&[[u32; 64]]> {
+        self.slots
+            .get_or_init(|| {
+                let asm = &self.asm;
+                if 9 * asm.nbr.len() >= u32::MAX as usize {
+                    return None;
+                }
+                Some(
+                    asm.src
+                        .par_iter()
+                        .with_min_len(256)
+                        .map(|src| {
+                            let mut s = [u32::MAX; 64];
+                            for a in 0..8 {
+                                let va = src[a];
+                                if va & FIXED_BIT != 0 {
+                                    continue;
+                                }
+                                for b in 0..8 {
+                                    let vb = src[b];
+                                    if vb & FIXED_BIT != 0 {
+                                        continue;
+                                    }
+                                    let k = asm.nbr_pos(va, vb);
+                                    // < 9·nbr.len() < u32::MAX, checked above
+                                    s[8 * a + b] =
+                                        (9 * asm.nbr_offsets[va as usize] + 3 * k) as u32;
+                                }
+                            }
+                            s
+                        })
+                        .collect(),
+                )
+            })
+            .as_deref()
+    }
+
+    /// `3·deg` of variable node `v`: the length of each of its three Hessian rows.
+    #[inline(always)]
+    fn row_len(&self, v: u32) -> usize {
+        3 * (self.asm.nbr_offsets[v as usize + 1] - self.asm.nbr_offsets[v as usize])
+    }
+
     /// Points of cell `c` and the variable-node index of each vertex ([`FIXED`] if fixed).
     #[inline(always)]
     fn cell_points(&self, x: &[f64], c: usize) -> ([DVec3; 8], [u32; 8]) {
@@ -381,11 +446,50 @@ impl HexTopology {
     }
 }
 
-/// A tet with its stencil already multiplied by the scaling factors.
+/// A tet with its stencil already multiplied by the scaling factors, and the two stencil
+/// invariants of its node-block Hessian (see [`tet_term_blocks`]).
 #[derive(Debug, Clone, Copy)]
 struct ScaledTet {
     nodes: [usize; 4],
     w: [[f64; 4]; 3],
+    /// `gram[j][l] = Σ_a w_aj w_al`.
+    gram: [[f64; 4]; 4],
+    /// `wx[j][l] = w_j × w_l` with `w_j = (w_0j, w_1j, w_2j)`.
+    wx: [[DVec3; 4]; 4],
+}
+
+impl ScaledTet {
+    fn new(nodes: [usize; 4], w: [[f64; 4]; 3]) -> Self {
+        let col = |j: usize| DVec3::new(w[0][j], w[1][j], w[2][j]);
+        Self {
+            nodes,
+            w,
+            gram: std::array::from_fn(|j| std::array::from_fn(|l| col(j).dot(col(l)))),
+            wx: std::array::from_fn(|j| std::array::from_fn(|l| col(j).cross(col(l)))),
+        }
+    }
+}
+
+/// The Hessian of one cell as 8×8 node blocks (`[a][b]` = the 3×3 block of local vertices `a`,
+/// `b`, row-major), the form the CSR slots of [`HexTopology::block_slots`] are written from.
+type CellBlocks = [[[f64; 9]; 8]; 8];
+
+/// Adds the 3×3 block `blk` at `(a, b)` and its transpose at `(b, a)` (once if `a == b`; the
+/// diagonal blocks built here are symmetric).
+#[inline(always)]
+fn add_block_sym(hb: &mut CellBlocks, a: usize, b: usize, blk: &[f64; 9]) {
+    if a == b {
+        for (o, v) in hb[a][a].iter_mut().zip(blk) {
+            *o += v;
+        }
+    } else {
+        for x in 0..3 {
+            for y in 0..3 {
+                hb[a][b][3 * x + y] += blk[3 * x + y];
+                hb[b][a][3 * y + x] += blk[3 * x + y];
+            }
+        }
+    }
 }
 
 /// `M(w)_{ij} = ε_{ijk} w_k`.
@@ -508,15 +612,153 @@ fn tet_term(
     val
 }
 
-/// One face term `C·k²` for the hex-local face `f`.
+/// One tet term `wt·λ·φ_ω(V)` in node-block form; adds the gradient to `g` and, if asked,
+/// the Hessian w.r.t. the tet's four vertices to the cell blocks `hb`.
+///
+/// With the columns `c_a = Σ_j w_aj X_j`, `α_j = Σ_a w_aj c_a`, `β_j = Σ_a w_aj ∂V/∂c_a`,
+/// `G_jl = Σ_a w_aj w_al` and `w_j = (w_0j, w_1j, w_2j)`, the chain rule
+/// `H_jl = Σ_ab w_aj w_bl ∂²f/∂c_a∂c_b` applied to the column Hessian of [`tet_term`]
+/// (`∂²λ = rI + c_a c_bᵀ/(3r)`, `∂²V/∂c_a∂c_b = ε_abc M(c_c)`) gives, in closed form,
+///
+/// `H_jl = wt·[φ·(r G_jl I + α_j α_lᵀ/(3r)) + φ'·r(α_j β_lᵀ + β_j α_lᵀ) + λφ''·β_j β_lᵀ
+///          + λφ'·M(Σ_c (w_j × w_l)_c c_c)]`
+///
+/// (`Σ_ab w_aj w_bl ε_abc = (w_j × w_l)_c`). Only the ten blocks `j ≤ l` are computed; the
+/// others are their transposes. Checked against [`tet_term`] (the 24×24 reference) in tests.
 #[inline(always)]
-fn face_term(
+fn tet_term_blocks(
+    t: &ScaledTet,
+    p: &[DVec3; 8],
+    omega: f64,
+    wt: f64,
+    g: &mut [DVec3; 8],
+    hb: Option<&mut CellBlocks>,
+) -> f64 {
+    let mut c = [DVec3::ZERO; 3];
+    for (a, ca) in c.iter_mut().enumerate() {
+        for j in 0..4 {
+            *ca += t.w[a][j] * p[t.nodes[j]];
+        }
+    }
+    let s = c[0].length_squared() + c[1].length_squared() + c[2].length_squared();
+    let r = (s / 3.0).sqrt();
+    let lam = r * r * r;
+    let dv = [c[1].cross(c[2]), c[2].cross(c[0]), c[0].cross(c[1])];
+    let v = c[0].dot(dv[0]);
+    let phi = phi_omega(omega, v);
+    let val = wt * lam * phi[0];
+    let al: [DVec3; 4] =
+        std::array::from_fn(|j| t.w[0][j] * c[0] + t.w[1][j] * c[1] + t.w[2][j] * c[2]);
+    let be: [DVec3; 4] =
+        std::array::from_fn(|j| t.w[0][j] * dv[0] + t.w[1][j] * dv[1] + t.w[2][j] * dv[2]);
+    let (kg, kb) = (wt * phi[0] * r, wt * lam * phi[1]);
+    for j in 0..4 {
+        g[t.nodes[j]] += kg * al[j] + kb * be[j];
+    }
+    if let Some(hb) = hb {
+        let inv3r = if r > 0.0 { 1.0 / (3.0 * r) } else { 0.0 };
+        let k0 = wt * phi[0] * r;
+        let k1 = wt * phi[0] * inv3r;
+        let k2 = wt * phi[1] * r;
+        let k3 = wt * lam * phi[2];
+        let k4 = kb;
+        // H_jl = k0 G_jl I + α_j P_lᵀ + β_j Q_lᵀ + M(z_jl)
+        let pp: [DVec3; 4] = std::array::from_fn(|l| k1 * al[l] + k2 * be[l]);
+        let qq: [DVec3; 4] = std::array::from_fn(|l| k2 * al[l] + k3 * be[l]);
+        for j in 0..4 {
+            let aj = al[j].to_array();
+            let bj = be[j].to_array();
+            for l in j..4 {
+                let pl = pp[l].to_array();
+                let ql = qq[l].to_array();
+                let mut blk = [0.0; 9];
+                for x in 0..3 {
+                    for y in 0..3 {
+                        blk[3 * x + y] = aj[x] * pl[y] + bj[x] * ql[y];
+                    }
+                }
+                let d = k0 * t.gram[j][l];
+                blk[0] += d;
+                blk[4] += d;
+                blk[8] += d;
+                if j != l {
+                    let wx = t.wx[j][l];
+                    let z = k4 * (wx.x * c[0] + wx.y * c[1] + wx.z * c[2]);
+                    // M(z)_{xy} = ε_{xyk} z_k
+                    blk[1] += z.z;
+                    blk[2] -= z.y;
+                    blk[3] -= z.z;
+                    blk[5] += z.x;
+                    blk[6] += z.y;
+                    blk[7] -= z.x;
+                }
+                add_block_sym(hb, t.nodes[j], t.nodes[l], &blk);
+            }
+        }
+    }
+    val
+}
+
+/// One face term `C·k²` in node-block form (the same derivatives as [`face_term`]; the legs
+/// `B−A, D−A, C−A` have stencil `+1` on their own vertex and `−1` on `A`, so the blocks are
+/// `H_{k l} = h_{kl}`, `H_{A l} = −Σ_k h_{kl}`, `H_{A A} = Σ_{kl} h_{kl}`).
+#[inline(always)]
+fn face_term_blocks(
     f: [usize; 4],
     p: &[DVec3; 8],
     cpen: f64,
     g: &mut [DVec3; 8],
-    h: Option<&mut [[f64; 24]; 24]>,
+    hb: Option<&mut CellBlocks>,
 ) -> f64 {
+    let want_h = hb.is_some();
+    let Some((val, gy, hc)) = face_parts(f, p, cpen, want_h) else {
+        return 0.0;
+    };
+    let (a, b, cc, d) = (f[0], f[1], f[2], f[3]);
+    let leg_node = [b, d, cc];
+    for k in 0..3 {
+        g[leg_node[k]] += gy[k];
+        g[a] -= gy[k];
+    }
+    if let (Some(hb), Some(hc)) = (hb, hc) {
+        let flat =
+            |k: usize, l: usize| -> [f64; 9] { std::array::from_fn(|e| hc[k][l][e / 3][e % 3]) };
+        let mut row_sum = [[0.0; 9]; 3]; // Σ_k h_{kl}, per l
+        let mut aa = [0.0; 9];
+        for k in 0..3 {
+            for l in k..3 {
+                let blk = flat(k, l);
+                add_block_sym(hb, leg_node[k], leg_node[l], &blk);
+            }
+            for l in 0..3 {
+                let blk = flat(k, l);
+                for e in 0..9 {
+                    row_sum[l][e] += blk[e];
+                    aa[e] += blk[e];
+                }
+            }
+        }
+        for l in 0..3 {
+            let neg: [f64; 9] = std::array::from_fn(|e| -row_sum[l][e]);
+            add_block_sym(hb, a, leg_node[l], &neg);
+        }
+        add_block_sym(hb, a, a, &aa);
+    }
+    val
+}
+
+/// Leg-Hessian blocks `h[k][l]` (3×3) of a face term w.r.t. its legs `B−A, D−A, C−A`.
+type LegHess = [[[[f64; 3]; 3]; 3]; 3];
+
+/// Value, leg gradients (w.r.t. `B−A, D−A, C−A`) and, with `want_h`, leg Hessian of the face
+/// term `C·k²` of the hex-local face `f`; `None` for a degenerate face (`n₂w₂ = 0`).
+#[inline(always)]
+fn face_parts(
+    f: [usize; 4],
+    p: &[DVec3; 8],
+    cpen: f64,
+    want_h: bool,
+) -> Option<(f64, [DVec3; 3], Option<LegHess>)> {
     let (a, b, cc, d) = (f[0], f[1], f[2], f[3]);
     // legs: u = B − A, v = D − A, w = C − A
     let y = [p[b] - p[a], p[d] - p[a], p[cc] - p[a]];
@@ -527,7 +769,7 @@ fn face_term(
     let w2 = w.length_squared();
     let dd = n2 * w2;
     if dd.is_nan() || dd <= 0.0 {
-        return 0.0;
+        return None;
     }
     let dt = [v.cross(w), w.cross(u), u.cross(v)];
     let t = u.dot(dt[0]);
@@ -543,11 +785,10 @@ fn face_term(
     let dw2 = [DVec3::ZERO, DVec3::ZERO, 2.0 * w];
     let d_den: [DVec3; 3] = std::array::from_fn(|k| w2 * dn2[k] + n2 * dw2[k]);
     let gy: [DVec3; 3] = std::array::from_fn(|k| gt * dt[k] + gd * d_den[k]);
-    g[b] += gy[0];
-    g[d] += gy[1];
-    g[cc] += gy[2];
-    g[a] -= gy[0] + gy[1] + gy[2];
-    if let Some(h) = h {
+    if !want_h {
+        return Some((val, gy, None));
+    }
+    {
         let gtt = cpen * 2.0 / dd;
         let gtd = -cpen * 2.0 * t / (dd * dd);
         let gdd = cpen * 2.0 * t * t / (dd * dd * dd);
@@ -591,6 +832,28 @@ fn face_term(
                 }
             }
         }
+        Some((val, gy, Some(hc)))
+    }
+}
+
+/// One face term `C·k²` for the hex-local face `f` (24×24 reference form).
+#[inline(always)]
+fn face_term(
+    f: [usize; 4],
+    p: &[DVec3; 8],
+    cpen: f64,
+    g: &mut [DVec3; 8],
+    h: Option<&mut [[f64; 24]; 24]>,
+) -> f64 {
+    let Some((val, gy, hc)) = face_parts(f, p, cpen, h.is_some()) else {
+        return 0.0;
+    };
+    let (a, b, cc, d) = (f[0], f[1], f[2], f[3]);
+    g[b] += gy[0];
+    g[d] += gy[1];
+    g[cc] += gy[2];
+    g[a] -= gy[0] + gy[1] + gy[2];
+    if let (Some(h), Some(hc)) = (h, hc) {
         let legs = [
             [(b, 1.0), (a, -1.0), (a, 0.0), (a, 0.0)],
             [(d, 1.0), (a, -1.0), (a, 0.0), (a, 0.0)],
@@ -621,9 +884,11 @@ impl HexFunctional {
     ) -> Result<Self, FunctionalError> {
         check_pos("omega", omega)?;
         let f = scaling.factors()?;
-        let tets = hex_tets().map(|t| ScaledTet {
-            nodes: t.nodes,
-            w: std::array::from_fn(|a| t.stencil[a].map(|v| v * f[t.dirs[a]])),
+        let tets = hex_tets().map(|t| {
+            ScaledTet::new(
+                t.nodes,
+                std::array::from_fn(|a| t.stencil[a].map(|v| v * f[t.dirs[a]])),
+            )
         });
         let h_scale = 1.0 / (10.0 * topo.num_cells() as f64);
         Ok(Self {
@@ -730,6 +995,88 @@ impl HexFunctional {
     }
 }
 
+impl HexFunctional {
+    /// Value of cell `c`, adding its gradient and (if asked) its node-block Hessian.
+    #[inline(always)]
+    fn cell_eval_blocks(
+        &self,
+        c: usize,
+        p: &[DVec3; 8],
+        g: &mut [DVec3; 8],
+        mut hb: Option<&mut CellBlocks>,
+    ) -> f64 {
+        let mut v = 0.0;
+        if let Some(w) = self.omega {
+            for t in &self.tets {
+                v += tet_term_blocks(t, p, w, self.h_scale, g, hb.as_deref_mut());
+            }
+        }
+        if let Some(cp) = self.coplanarity {
+            if self.topo.interior[c] {
+                for f in HEX_QUAD_FACES {
+                    v += face_term_blocks(f, p, cp, g, hb.as_deref_mut());
+                }
+            }
+        }
+        v
+    }
+
+    /// The Hessian by the original per-tetrahedron assembly: each term's column Hessian is
+    /// spread over a 24×24 cell matrix (`scatter_hess3`), whose entries are then located in the
+    /// CSR rows by binary search. Kept as the reference the node-block
+    /// [`Problem::hessian`] is tested against (same values up to rounding) and as the
+    /// benchmark baseline; `h` must come from [`Problem::hessian_pattern`].
+    ///
+    /// # Panics
+    /// If `x` or `h` do not fit the mesh.
+    pub fn hessian_reference(&self, x: &[f64], h: &mut Csr) {
+        assert_eq!(x.len(), self.num_vars(), "hessian: x has the wrong length");
+        assert!(
+            self.topo.asm.matches_pattern(3, h),
+            "hessian: matrix does not come from hessian_pattern"
+        );
+        let Csr {
+            row_offsets,
+            values,
+            ..
+        } = h;
+        values
+            .par_iter_mut()
+            .with_min_len(4096)
+            .for_each(|v| *v = 0.0);
+        let hp = SyncPtr::new(values);
+        let ro: &[usize] = row_offsets;
+        let asm = &self.topo.asm;
+        asm.run_colored(|c| {
+            let (p, vars) = self.topo.cell_points(x, c);
+            let mut lg = [DVec3::ZERO; 8];
+            let mut lh = [[0.0; 24]; 24];
+            self.cell_eval(c, &p, None, &mut lg, Some(&mut lh));
+            for i in 0..8 {
+                let vi = vars[i];
+                if vi == FIXED {
+                    continue;
+                }
+                for jn in 0..8 {
+                    let vj = vars[jn];
+                    if vj == FIXED {
+                        continue;
+                    }
+                    let k = asm.nbr_pos(vi, vj);
+                    for dx in 0..3 {
+                        let base = ro[3 * vi as usize + dx] + 3 * k;
+                        for dy in 0..3 {
+                            // SAFETY: row of a node of this cell; see `assembly`.
+                            unsafe { hp.add(base + dy, lh[3 * i + dx][3 * jn + dy]) };
+                        }
+                    }
+                }
+            }
+            0.0
+        });
+    }
+}
+
 fn check_pos(name: &'static str, v: f64) -> Result<f64, FunctionalError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -813,6 +1160,12 @@ impl Problem for HexFunctional {
         self.topo.hessian_pattern()
     }
 
+    /// Node-block assembly (issue #10): per cell the Hessian w.r.t. its eight vertices is built
+    /// as 8×8 closed-form 3×3 blocks (`tet_term_blocks`, `face_term_blocks`, see the module docs) and added at
+    /// the CSR positions precomputed once with the pattern ([`HexTopology::block_slots`]).
+    /// Cells run in the deterministic chunk colouring of `assembly` (bit-identical for any
+    /// thread count). Falls back to [`HexFunctional::hessian_reference`] when the slot table
+    /// cannot be built (more than `u32::MAX` entries).
     fn hessian(&self, x: &[f64], h: &mut Csr) {
         assert_eq!(x.len(), self.num_vars(), "hessian: x has the wrong length");
         assert_eq!(
@@ -824,39 +1177,40 @@ impl Problem for HexFunctional {
             self.topo.asm.matches_pattern(3, h),
             "hessian: matrix does not come from hessian_pattern"
         );
-        let Csr {
-            row_offsets,
-            values,
-            ..
-        } = h;
+        let Some(slots) = self.topo.block_slots() else {
+            self.hessian_reference(x, h);
+            return;
+        };
+        let values = &mut h.values;
         values
             .par_iter_mut()
             .with_min_len(4096)
             .for_each(|v| *v = 0.0);
         let hp = SyncPtr::new(values);
-        let ro: &[usize] = row_offsets;
-        let asm = &self.topo.asm;
-        asm.run_colored(|c| {
-            let (p, vars) = self.topo.cell_points(x, c);
+        let topo = &*self.topo;
+        topo.asm.run_colored(|c| {
+            let (p, vars) = topo.cell_points(x, c);
             let mut lg = [DVec3::ZERO; 8];
-            let mut lh = [[0.0; 24]; 24];
-            self.cell_eval(c, &p, None, &mut lg, Some(&mut lh));
-            for i in 0..8 {
-                let vi = vars[i];
-                if vi == FIXED {
+            let mut hb: CellBlocks = [[[0.0; 9]; 8]; 8];
+            self.cell_eval_blocks(c, &p, &mut lg, Some(&mut hb));
+            let sl = &slots[c];
+            for a in 0..8 {
+                if vars[a] == FIXED {
                     continue;
                 }
-                for jn in 0..8 {
-                    let vj = vars[jn];
-                    if vj == FIXED {
+                let rl = topo.row_len(vars[a]);
+                for b in 0..8 {
+                    let s0 = sl[8 * a + b];
+                    if s0 == u32::MAX {
                         continue;
                     }
-                    let k = asm.nbr_pos(vi, vj);
+                    let blk = &hb[a][b];
                     for dx in 0..3 {
-                        let base = ro[3 * vi as usize + dx] + 3 * k;
+                        let base = s0 as usize + dx * rl;
                         for dy in 0..3 {
-                            // SAFETY: row of a node of this cell; see `assembly`.
-                            unsafe { hp.add(base + dy, lh[3 * i + dx][3 * jn + dy]) };
+                            // SAFETY: a block of two nodes of this cell (slot table built from
+                            // the same pattern, checked by `matches_pattern`); see `assembly`.
+                            unsafe { hp.add(base + dy, blk[3 * dx + dy]) };
                         }
                     }
                 }
@@ -875,28 +1229,35 @@ impl Problem for HexFunctional {
         self.topo.asm.run_colored(|c| {
             let (p, vars) = self.topo.cell_points(x, c);
             let mut lg = [DVec3::ZERO; 8];
-            let mut lh = [[0.0; 24]; 24];
-            self.cell_eval(c, &p, None, &mut lg, Some(&mut lh));
-            let mut lv = [0.0; 24];
-            for i in 0..8 {
-                if vars[i] != FIXED {
-                    let j = 3 * vars[i] as usize;
-                    lv[3 * i..3 * i + 3].copy_from_slice(&v[j..j + 3]);
+            let mut hb: CellBlocks = [[[0.0; 9]; 8]; 8];
+            self.cell_eval_blocks(c, &p, &mut lg, Some(&mut hb));
+            let mut lv = [DVec3::ZERO; 8];
+            for b in 0..8 {
+                if vars[b] != FIXED {
+                    let j = 3 * vars[b] as usize;
+                    lv[b] = DVec3::new(v[j], v[j + 1], v[j + 2]);
                 }
             }
-            for i in 0..8 {
-                if vars[i] == FIXED {
+            for a in 0..8 {
+                if vars[a] == FIXED {
                     continue;
                 }
-                let j = 3 * vars[i] as usize;
+                let mut acc = [0.0; 3];
+                for b in 0..8 {
+                    if vars[b] == FIXED {
+                        continue;
+                    }
+                    let blk = &hb[a][b];
+                    for dx in 0..3 {
+                        acc[dx] += blk[3 * dx] * lv[b].x
+                            + blk[3 * dx + 1] * lv[b].y
+                            + blk[3 * dx + 2] * lv[b].z;
+                    }
+                }
+                let j = 3 * vars[a] as usize;
                 for dx in 0..3 {
-                    let acc: f64 = lh[3 * i + dx]
-                        .iter()
-                        .zip(lv.iter())
-                        .map(|(a, b)| a * b)
-                        .sum();
                     // SAFETY: node of this cell; see `assembly`.
-                    unsafe { op.add(j + dx, acc) };
+                    unsafe { op.add(j + dx, acc[dx]) };
                 }
             }
             0.0
@@ -956,6 +1317,145 @@ impl Problem for HexFunctional {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An `m × n × p`-node grid of the unit-spaced box with every interior node moved by a
+    /// deterministic pseudo-random offset of size up to `amp` (amp > ~0.5 folds cells).
+    fn grid(m: usize, n: usize, p: usize, amp: f64) -> HexTopology {
+        let id = |i: usize, j: usize, k: usize| i + m * (j + n * k);
+        let mut nodes = Vec::new();
+        let mut fixed = Vec::new();
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for k in 0..p {
+            for j in 0..n {
+                for i in 0..m {
+                    let b = i == 0 || j == 0 || k == 0 || i == m - 1 || j == n - 1 || k == p - 1;
+                    let mut q = DVec3::new(i as f64, j as f64, 1.3 * k as f64);
+                    if !b {
+                        q += amp * DVec3::new(rnd(), rnd(), rnd());
+                    }
+                    nodes.push(q);
+                    fixed.push(b);
+                }
+            }
+        }
+        let mut cells = Vec::new();
+        for k in 0..p - 1 {
+            for j in 0..n - 1 {
+                for i in 0..m - 1 {
+                    cells.push([
+                        id(i, j, k),
+                        id(i + 1, j, k),
+                        id(i + 1, j + 1, k),
+                        id(i, j + 1, k),
+                        id(i, j, k + 1),
+                        id(i + 1, j, k + 1),
+                        id(i + 1, j + 1, k + 1),
+                        id(i, j + 1, k + 1),
+                    ]);
+                }
+            }
+        }
+        HexTopology::new(nodes, cells, fixed).unwrap()
+    }
+
+    #[test]
+    fn node_block_hessian_equals_the_reference_assembly_and_hess_vec() {
+        // convex and folded starts; every term kind (both ω branches, coplanarity only, both)
+        for amp in [0.3, 1.4] {
+            let topo = Arc::new(grid(6, 5, 5, amp));
+            let x = topo.initial_x();
+            let fs = [
+                HexFunctional::h_omega(topo.clone(), 0.7, Scaling3::Index).unwrap(),
+                HexFunctional::h_omega(topo.clone(), 40.0, Scaling3::Custom([1.0, 2.0, 0.5]))
+                    .unwrap(),
+                HexFunctional::coplanarity(topo.clone(), 3.0).unwrap(),
+                HexFunctional::h_omega(
+                    topo.clone(),
+                    0.2,
+                    Scaling3::Parametric { m: 6, n: 5, p: 5 },
+                )
+                .unwrap()
+                .with_coplanarity(0.9)
+                .unwrap(),
+            ];
+            for (fi, f) in fs.iter().enumerate() {
+                let mut h = f.hessian_pattern();
+                let mut r = f.hessian_pattern();
+                f.hessian(&x, &mut h);
+                f.hessian_reference(&x, &mut r);
+                let scale = r.values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                assert!(scale > 0.0);
+                for (k, (a, b)) in h.values.iter().zip(&r.values).enumerate() {
+                    // the same sums in another order: rounding-level differences only
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "f{fi} amp {amp} entry {k}: {a} vs {b}"
+                    );
+                }
+                // the assembled matrix is symmetric
+                for row in 0..h.nrows {
+                    for e in h.row_offsets[row]..h.row_offsets[row + 1] {
+                        let col = h.col_indices[e] as usize;
+                        assert!((h.values[e] - h.get(col, row)).abs() <= 1e-12 * scale);
+                    }
+                }
+                // the matrix-free product equals the CSR product
+                let v: Vec<f64> = (0..f.num_vars())
+                    .map(|i| ((i * 7919) % 13) as f64 - 6.0)
+                    .collect();
+                let mut hv = vec![0.0; v.len()];
+                let mut mv = vec![0.0; v.len()];
+                f.hess_vec(&x, &v, &mut hv);
+                h.mul_vec(&v, &mut mv);
+                for (a, b) in hv.iter().zip(&mv) {
+                    assert!((a - b).abs() <= 1e-10 * scale, "{a} vs {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn block_slots_point_at_the_block_entries() {
+        let topo = grid(5, 5, 4, 0.2);
+        let f = HexFunctional::h_omega(Arc::new(grid(5, 5, 4, 0.2)), 1.0, Scaling3::Index).unwrap();
+        let h = f.hessian_pattern();
+        let slots = topo.block_slots().unwrap();
+        for (c, sl) in slots.iter().enumerate() {
+            for a in 0..8 {
+                for b in 0..8 {
+                    let (va, vb) = (
+                        topo.var_of(topo.asm.cells[c][a] as usize),
+                        topo.var_of(topo.asm.cells[c][b] as usize),
+                    );
+                    match (va, vb) {
+                        (Some(va), Some(vb)) => {
+                            let s0 = sl[8 * a + b] as usize;
+                            // row 3va + dx, column 3vb + dy
+                            for dx in 0..3 {
+                                let rl =
+                                    3 * (topo.asm.nbr_offsets[va + 1] - topo.asm.nbr_offsets[va]);
+                                for dy in 0..3 {
+                                    let e = s0 + dx * rl + dy;
+                                    assert!(
+                                        e >= h.row_offsets[3 * va + dx]
+                                            && e < h.row_offsets[3 * va + dx + 1]
+                                    );
+                                    assert_eq!(h.col_indices[e] as usize, 3 * vb + dy);
+                                }
+                            }
+                        }
+                        _ => assert_eq!(sl[8 * a + b], u32::MAX),
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn all_ten_tets_are_positive_on_the_unit_cube_and_interior_ones_have_v_3vol() {

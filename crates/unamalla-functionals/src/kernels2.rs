@@ -160,6 +160,256 @@ pub trait TriKernel: Send + Sync {
         let p = self.eval(s, Order::Gradient);
         (p.v, p.g)
     }
+    /// Values of the four corner terms of one cell (lane `k` = corner `k`): the hot path of the
+    /// fast 2D evaluator ([`crate::quad`]). The default calls [`value`](Self::value) per lane;
+    /// after inlining, the four lanes are independent and the compiler vectorizes them.
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        [
+            self.value(&s.lane(0)),
+            self.value(&s.lane(1)),
+            self.value(&s.lane(2)),
+            self.value(&s.lane(3)),
+        ]
+    }
+    /// Values and first partials of the four corner terms of one cell ([`LaneGrad`]). The
+    /// default calls [`value_grad`](Self::value_grad) per lane; combinators combine lane-wise
+    /// so that a monomorphized sum is one straight-line, vectorizable computation.
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        let mut out = LaneGrad::default();
+        for k in 0..4 {
+            let (v, g) = self.value_grad(&s.lane(k));
+            out.v[k] = v;
+            for i in 0..4 {
+                out.g[i][k] = g[i];
+            }
+        }
+        out
+    }
+    /// Values, first and second partials of the four corner terms of one cell
+    /// ([`LanePartials`]); the default calls [`eval`](Self::eval) with [`Order::Hessian`] per
+    /// lane.
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        let mut out = LanePartials::default();
+        for k in 0..4 {
+            let p = self.eval(&s.lane(k), Order::Hessian);
+            out.v[k] = p.v;
+            for i in 0..4 {
+                out.g[i][k] = p.g[i];
+                for j in 0..4 {
+                    out.h[i][j][k] = p.h[i][j];
+                }
+            }
+        }
+        out
+    }
+    /// Which second partials `∂²f/∂sᵢ∂sⱼ` (`s = (α, la, lb, o)`) may be non-zero. The fast
+    /// Hessian path skips the others; for a typed kernel the answer is a constant, so the
+    /// skipped products are removed at compile time. The default (all `true`) is always correct;
+    /// an override must only clear entries that [`eval`](Self::eval) leaves at zero.
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        [[true; 4]; 4]
+    }
+    /// `Some(self)` if this kernel is a run-time [`Kernel2`] (or wraps one), so that the
+    /// evaluator can flatten it once and route it to a monomorphized fused kernel
+    /// ([`Kernel2::flattened`]); `None` for every other kernel (the default).
+    fn as_kernel2(&self) -> Option<&Kernel2> {
+        None
+    }
+}
+
+/// The scalars of the four corner triangles of one cell, one **lane** per corner (lane `k` is
+/// corner `k`: `a = v_{k+1} − v_k`, `b = v_{k−1} − v_k`), in structure-of-arrays form so that the
+/// per-corner arithmetic of a kernel runs on all four corners at once (SIMD).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CornerLanes {
+    /// `α` per corner.
+    pub alpha: [f64; 4],
+    /// `|a|²` per corner.
+    pub la: [f64; 4],
+    /// `|b|²` per corner.
+    pub lb: [f64; 4],
+    /// `a·b` per corner.
+    pub o: [f64; 4],
+    /// Cell id.
+    pub cell: usize,
+}
+
+impl CornerLanes {
+    /// The scalars of corner `k` (`k < 4`).
+    #[inline(always)]
+    pub fn lane(&self, k: usize) -> TriScalars {
+        TriScalars {
+            alpha: self.alpha[k],
+            la: self.la[k],
+            lb: self.lb[k],
+            o: self.o[k],
+            cell: self.cell,
+            corner: k as u8,
+        }
+    }
+}
+
+/// Values and first partials of the four corner terms of a cell: `v[k]` and `g[s][k]` =
+/// `∂f/∂s` of corner `k`, `s` indexed as in [`Partials`] (`α`, `la`, `lb`, `o`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LaneGrad {
+    /// Value per corner.
+    pub v: [f64; 4],
+    /// `g[s][k] = ∂f_k/∂s`.
+    pub g: [[f64; 4]; 4],
+}
+
+impl LaneGrad {
+    /// `self += w·o`, lane-wise.
+    #[inline(always)]
+    pub fn add_scaled(&mut self, w: f64, o: &LaneGrad) {
+        for k in 0..4 {
+            self.v[k] += w * o.v[k];
+        }
+        for i in 0..4 {
+            for k in 0..4 {
+                self.g[i][k] += w * o.g[i][k];
+            }
+        }
+    }
+    /// `self += w_k·o` with one weight per lane.
+    #[inline(always)]
+    pub fn add_scaled_lanes(&mut self, w: &[f64; 4], o: &LaneGrad) {
+        for k in 0..4 {
+            self.v[k] += w[k] * o.v[k];
+        }
+        for i in 0..4 {
+            for k in 0..4 {
+                self.g[i][k] += w[k] * o.g[i][k];
+            }
+        }
+    }
+}
+
+/// Values, first and second partials of the four corner terms of a cell: `h[s][t][k]` =
+/// `∂²f_k/∂s∂t`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LanePartials {
+    /// Value per corner.
+    pub v: [f64; 4],
+    /// `g[s][k] = ∂f_k/∂s`.
+    pub g: [[f64; 4]; 4],
+    /// `h[s][t][k] = ∂²f_k/∂s∂t` (symmetric in `s`, `t`).
+    pub h: [[[f64; 4]; 4]; 4],
+}
+
+impl LanePartials {
+    /// `self += w·o`, lane-wise.
+    #[inline(always)]
+    pub fn add_scaled(&mut self, w: f64, o: &LanePartials) {
+        self.add_scaled_masked(w, o, &[[true; 4]; 4]);
+    }
+    /// `self += w·o` on the second partials marked in `mask` only (the others of `o` must be
+    /// zero, e.g. `mask` = the [`TriKernel::hessian_sparsity`] of the kernel that produced
+    /// `o`; for a typed kernel the mask is a constant and the skipped products vanish at
+    /// compile time).
+    #[inline(always)]
+    pub fn add_scaled_masked(&mut self, w: f64, o: &LanePartials, mask: &[[bool; 4]; 4]) {
+        for k in 0..4 {
+            self.v[k] += w * o.v[k];
+        }
+        for i in 0..4 {
+            for k in 0..4 {
+                self.g[i][k] += w * o.g[i][k];
+            }
+            for j in 0..4 {
+                if mask[i][j] {
+                    for k in 0..4 {
+                        self.h[i][j][k] += w * o.h[i][j][k];
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn axpy_lanes(acc: &mut [f64; 4], w: f64, o: [f64; 4]) {
+    for k in 0..4 {
+        acc[k] += w * o[k];
+    }
+}
+
+/// Sparsity of `∂²f/∂s²` with the given `(i, j)` entries (and their transposes) non-zero.
+pub(crate) const fn sparsity(entries: &[(usize, usize)]) -> [[bool; 4]; 4] {
+    let mut m = [[false; 4]; 4];
+    let mut k = 0;
+    while k < entries.len() {
+        let (i, j) = entries[k];
+        m[i][j] = true;
+        m[j][i] = true;
+        k += 1;
+    }
+    m
+}
+
+/// Entry-wise `a ∨ b` of two sparsity patterns.
+#[inline(always)]
+pub(crate) fn sparsity_or(a: [[bool; 4]; 4], b: [[bool; 4]; 4]) -> [[bool; 4]; 4] {
+    let mut m = a;
+    for i in 0..4 {
+        for j in 0..4 {
+            m[i][j] |= b[i][j];
+        }
+    }
+    m
+}
+
+const SP_NONE: [[bool; 4]; 4] = [[false; 4]; 4];
+const SP_ALPHA: [[bool; 4]; 4] = sparsity(&[(S_ALPHA, S_ALPHA)]);
+const SP_L_PHI: [[bool; 4]; 4] = sparsity(&[(S_ALPHA, S_ALPHA), (S_ALPHA, S_LA), (S_ALPHA, S_LB)]);
+
+/// Lane form of `n_times_phi` with `wa = wb = 1`, `c = 0` (`f = (la + lb)·φ(α)`), for
+/// `φ = [φ, φ′, φ″]` given per lane; the same operations per lane as the scalar form.
+#[inline(always)]
+fn l_times_phi_lanes(s: &CornerLanes, phi: &[[f64; 4]; 3], hessian: bool) -> LanePartials {
+    let mut p = LanePartials::default();
+    for q in 0..4 {
+        let n = s.la[q] + s.lb[q];
+        p.v[q] = n * phi[0][q];
+        p.g[S_ALPHA][q] = n * phi[1][q];
+        p.g[S_LA][q] = phi[0][q];
+        p.g[S_LB][q] = phi[0][q];
+        if hessian {
+            p.h[S_ALPHA][S_ALPHA][q] = n * phi[2][q];
+            p.h[S_ALPHA][S_LA][q] = phi[1][q];
+            p.h[S_LA][S_ALPHA][q] = phi[1][q];
+            p.h[S_ALPHA][S_LB][q] = phi[1][q];
+            p.h[S_LB][S_ALPHA][q] = phi[1][q];
+        }
+    }
+    p
+}
+
+#[inline(always)]
+fn lane_grad(p: LanePartials) -> LaneGrad {
+    LaneGrad { v: p.v, g: p.g }
+}
+
+/// `φ_ω` on four lanes (the same branch-free selection as [`phi_omega`]).
+#[inline(always)]
+fn phi_omega_lanes(omega: f64, a: &[f64; 4], second: bool) -> [[f64; 4]; 3] {
+    let w2 = 1.0 / (omega * omega);
+    let mut out = [[0.0; 4]; 3];
+    for q in 0..4 {
+        let r = 1.0 / a[q];
+        let hi = a[q] >= omega;
+        out[0][q] = if hi { r } else { (2.0 * omega - a[q]) * w2 };
+        out[1][q] = if hi { -r * r } else { -w2 };
+        if second {
+            out[2][q] = if hi { 2.0 * r * r * r } else { 0.0 };
+        }
+    }
+    out
 }
 
 #[inline(always)]
@@ -185,6 +435,25 @@ impl<T: TriKernel + ?Sized> TriKernel for Arc<T> {
     #[inline(always)]
     fn value_grad(&self, s: &TriScalars) -> (f64, [f64; 4]) {
         (**self).value_grad(s)
+    }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        (**self).corners_value(s)
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        (**self).corners_value_grad(s)
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        (**self).corners_hessian(s)
+    }
+    fn as_kernel2(&self) -> Option<&Kernel2> {
+        (**self).as_kernel2()
+    }
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        (**self).hessian_sparsity()
     }
 }
 
@@ -353,6 +622,10 @@ fn leg_weights(corner: u8, wxi: f64, weta: f64) -> (f64, f64) {
 pub struct Length;
 impl TriKernel for Length {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_NONE
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         n_times_phi(1.0, 1.0, 0.0, [1.0, 0.0, 0.0], s, order)
     }
@@ -379,6 +652,10 @@ impl WeightedLength {
 }
 impl TriKernel for WeightedLength {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_NONE
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let (wa, wb) = leg_weights(s.corner, 2.0 * self.omega, 2.0 * (1.0 - self.omega));
         n_times_phi(wa, wb, 0.0, [1.0, 0.0, 0.0], s, order)
@@ -390,6 +667,10 @@ impl TriKernel for WeightedLength {
 pub struct Area;
 impl TriKernel for Area {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         of_alpha([s.alpha * s.alpha, 2.0 * s.alpha, 2.0], order)
     }
@@ -400,6 +681,10 @@ impl TriKernel for Area {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct CastilloArea;
 impl TriKernel for CastilloArea {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
     #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         if s.corner != DIAGONAL {
@@ -430,6 +715,10 @@ impl A4P {
 }
 impl TriKernel for A4P {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let d = s.alpha - self.alpha_bar;
         let d2 = d * d;
@@ -441,6 +730,10 @@ impl TriKernel for A4P {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Orthogonality;
 impl TriKernel for Orthogonality {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        sparsity(&[(S_O, S_O)])
+    }
     #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let mut p = Partials {
@@ -464,6 +757,10 @@ impl TriKernel for Orthogonality {
 pub struct AreaOrthogonality;
 impl TriKernel for AreaOrthogonality {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        sparsity(&[(S_LA, S_LB)])
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let mut p = Partials {
             v: 0.5 * s.la * s.lb,
@@ -477,6 +774,36 @@ impl TriKernel for AreaOrthogonality {
             p.h[S_LA][S_LB] = 0.5;
             p.h[S_LB][S_LA] = 0.5;
         }
+        p
+    }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        let mut v = [0.0; 4];
+        for q in 0..4 {
+            v[q] = 0.5 * s.la[q] * s.lb[q];
+        }
+        v
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        let mut p = LaneGrad::default();
+        for q in 0..4 {
+            p.v[q] = 0.5 * s.la[q] * s.lb[q];
+            p.g[S_LA][q] = 0.5 * s.lb[q];
+            p.g[S_LB][q] = 0.5 * s.la[q];
+        }
+        p
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        let g = self.corners_value_grad(s);
+        let mut p = LanePartials {
+            v: g.v,
+            g: g.g,
+            ..Default::default()
+        };
+        p.h[S_LA][S_LB] = [0.5; 4];
+        p.h[S_LB][S_LA] = [0.5; 4];
         p
     }
 }
@@ -549,6 +876,10 @@ impl Smoothness {
 }
 impl TriKernel for Smoothness {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_L_PHI
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let (wa, wb) = self.weights.as_ref().map_or((1.0, 1.0), |w| w.legs(s));
         let r = 1.0 / s.alpha;
@@ -583,6 +914,10 @@ impl RegularizedSmoothness {
 }
 impl TriKernel for RegularizedSmoothness {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_L_PHI
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let (wa, wb) = self.weights.as_ref().map_or((1.0, 1.0), |w| w.legs(s));
         n_times_phi(wa, wb, 0.0, phi_regularized(self.eps_c, s.alpha), s, order)
@@ -605,6 +940,10 @@ impl RegularizedInverseArea {
 }
 impl TriKernel for RegularizedInverseArea {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         of_alpha(phi_regularized(self.eps_c, s.alpha), order)
     }
@@ -623,6 +962,10 @@ impl<F: Fn(f64) -> [f64; 3] + Send + Sync> GenericArea<F> {
     }
 }
 impl<F: Fn(f64) -> [f64; 3] + Send + Sync> TriKernel for GenericArea<F> {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
     #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         of_alpha((self.f)(s.alpha), order)
@@ -680,6 +1023,10 @@ impl KSmoothness {
 }
 impl TriKernel for KSmoothness {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_L_PHI
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         n_times_phi(
             1.0,
@@ -711,6 +1058,10 @@ impl KArea {
     }
 }
 impl TriKernel for KArea {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
     #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         of_alpha(inv_k(self.k, self.alpha_hat, s.alpha), order)
@@ -758,6 +1109,10 @@ impl SOmegaEps {
 }
 impl TriKernel for SOmegaEps {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let (t, dt) = match self.arg {
             SArgument::ScaleInvariant => {
@@ -791,8 +1146,33 @@ impl HOmega {
 }
 impl TriKernel for HOmega {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_L_PHI
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         n_times_phi(1.0, 1.0, 0.0, phi_omega(self.omega, s.alpha), s, order)
+    }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        let phi = phi_omega_lanes(self.omega, &s.alpha, false);
+        let mut v = [0.0; 4];
+        for q in 0..4 {
+            v[q] = (s.la[q] + s.lb[q]) * phi[0][q];
+        }
+        v
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        lane_grad(l_times_phi_lanes(
+            s,
+            &phi_omega_lanes(self.omega, &s.alpha, false),
+            false,
+        ))
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        l_times_phi_lanes(s, &phi_omega_lanes(self.omega, &s.alpha, true), true)
     }
 }
 
@@ -808,6 +1188,10 @@ pub struct Scaled<K> {
     pub inner: K,
 }
 impl<K: TriKernel> TriKernel for Scaled<K> {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        self.inner.hessian_sparsity()
+    }
     #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let mut p = self.inner.eval(s, order);
@@ -825,6 +1209,25 @@ impl<K: TriKernel> TriKernel for Scaled<K> {
     fn value_grad(&self, s: &TriScalars) -> (f64, [f64; 4]) {
         let mut acc = (0.0, [0.0; 4]);
         axpy4(&mut acc, self.factor, self.inner.value_grad(s));
+        acc
+    }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        let mut acc = [0.0; 4];
+        axpy_lanes(&mut acc, self.factor, self.inner.corners_value(s));
+        acc
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        let mut acc = LaneGrad::default();
+        acc.add_scaled(self.factor, &self.inner.corners_value_grad(s));
+        acc
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        let mut acc = LanePartials::default();
+        let m = self.inner.hessian_sparsity();
+        acc.add_scaled_masked(self.factor, &self.inner.corners_hessian(s), &m);
         acc
     }
 }
@@ -861,6 +1264,10 @@ impl<A: TriKernel, B: TriKernel> Sum<A, B> {
     }
 }
 impl<A: TriKernel, B: TriKernel> TriKernel for Sum<A, B> {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        sparsity_or(self.a.hessian_sparsity(), self.b.hessian_sparsity())
+    }
     #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let mut p = Partials::default();
@@ -899,6 +1306,41 @@ impl<A: TriKernel, B: TriKernel> TriKernel for Sum<A, B> {
         }
         acc
     }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        let mut acc = [0.0; 4];
+        if self.a.terms().corners {
+            axpy_lanes(&mut acc, self.wa, self.a.corners_value(s));
+        }
+        if self.b.terms().corners {
+            axpy_lanes(&mut acc, self.wb, self.b.corners_value(s));
+        }
+        acc
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        let mut acc = LaneGrad::default();
+        if self.a.terms().corners {
+            acc.add_scaled(self.wa, &self.a.corners_value_grad(s));
+        }
+        if self.b.terms().corners {
+            acc.add_scaled(self.wb, &self.b.corners_value_grad(s));
+        }
+        acc
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        let mut acc = LanePartials::default();
+        if self.a.terms().corners {
+            let m = self.a.hessian_sparsity();
+            acc.add_scaled_masked(self.wa, &self.a.corners_hessian(s), &m);
+        }
+        if self.b.terms().corners {
+            let m = self.b.hessian_sparsity();
+            acc.add_scaled_masked(self.wb, &self.b.corners_hessian(s), &m);
+        }
+        acc
+    }
 }
 
 /// `w_c · inner` with one weight per cell (the boundary density `w` of seed 000 (6.9)).
@@ -930,6 +1372,10 @@ impl<K: TriKernel> CellWeighted<K> {
 }
 impl<K: TriKernel> TriKernel for CellWeighted<K> {
     #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        self.inner.hessian_sparsity()
+    }
+    #[inline(always)]
     fn eval(&self, s: &TriScalars, order: Order) -> Partials {
         let w = self.weights.get(s.cell).copied().unwrap_or(1.0);
         let mut p = self.inner.eval(s, order);
@@ -948,6 +1394,28 @@ impl<K: TriKernel> TriKernel for CellWeighted<K> {
         let mut acc = (0.0, [0.0; 4]);
         let w = self.weights.get(s.cell).copied().unwrap_or(1.0);
         axpy4(&mut acc, w, self.inner.value_grad(s));
+        acc
+    }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        let mut acc = [0.0; 4];
+        let w = self.weights.get(s.cell).copied().unwrap_or(1.0);
+        axpy_lanes(&mut acc, w, self.inner.corners_value(s));
+        acc
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        let mut acc = LaneGrad::default();
+        let w = self.weights.get(s.cell).copied().unwrap_or(1.0);
+        acc.add_scaled(w, &self.inner.corners_value_grad(s));
+        acc
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        let mut acc = LanePartials::default();
+        let w = self.weights.get(s.cell).copied().unwrap_or(1.0);
+        let m = self.inner.hessian_sparsity();
+        acc.add_scaled_masked(w, &self.inner.corners_hessian(s), &m);
         acc
     }
 }
@@ -1136,6 +1604,18 @@ macro_rules! kernel2_leaf {
 
 impl TriKernel for Kernel2 {
     #[inline]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        match self {
+            Kernel2::CastilloArea => SP_ALPHA,
+            Kernel2::Combination(v) => v
+                .iter()
+                .fold(SP_NONE, |m, (_, k)| sparsity_or(m, k.hessian_sparsity())),
+            Kernel2::CellWeighted(_, k) => k.hessian_sparsity(),
+            Kernel2::Custom(k) => k.hessian_sparsity(),
+            leaf => kernel2_leaf!(leaf, k => k.hessian_sparsity(), [[true; 4]; 4]),
+        }
+    }
+    #[inline]
     fn value(&self, s: &TriScalars) -> f64 {
         match self {
             Kernel2::CastilloArea => CastilloArea.value(s),
@@ -1233,6 +1713,112 @@ impl TriKernel for Kernel2 {
             Kernel2::CellWeighted(_, k) => k.terms(),
             Kernel2::Custom(k) => k.terms(),
             _ => CORNERS,
+        }
+    }
+    #[inline]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        match self {
+            Kernel2::CastilloArea => [0.0; 4],
+            Kernel2::Combination(v) => {
+                let mut acc = [0.0; 4];
+                for (w, k) in v {
+                    if k.terms().corners {
+                        axpy_lanes(&mut acc, *w, k.corners_value(s));
+                    }
+                }
+                acc
+            }
+            Kernel2::CellWeighted(w, k) => {
+                let mut acc = [0.0; 4];
+                axpy_lanes(
+                    &mut acc,
+                    w.get(s.cell).copied().unwrap_or(1.0),
+                    k.corners_value(s),
+                );
+                acc
+            }
+            Kernel2::Custom(k) => k.corners_value(s),
+            leaf => kernel2_leaf!(leaf, k => k.corners_value(s), [0.0; 4]),
+        }
+    }
+    #[inline]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        match self {
+            Kernel2::CastilloArea => LaneGrad::default(),
+            Kernel2::Combination(v) => {
+                let mut acc = LaneGrad::default();
+                for (w, k) in v {
+                    if k.terms().corners {
+                        acc.add_scaled(*w, &k.corners_value_grad(s));
+                    }
+                }
+                acc
+            }
+            Kernel2::CellWeighted(w, k) => {
+                let mut acc = LaneGrad::default();
+                acc.add_scaled(
+                    w.get(s.cell).copied().unwrap_or(1.0),
+                    &k.corners_value_grad(s),
+                );
+                acc
+            }
+            Kernel2::Custom(k) => k.corners_value_grad(s),
+            leaf => kernel2_leaf!(leaf, k => k.corners_value_grad(s), LaneGrad::default()),
+        }
+    }
+    #[inline]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        match self {
+            Kernel2::CastilloArea => LanePartials::default(),
+            Kernel2::Combination(v) => {
+                let mut acc = LanePartials::default();
+                for (w, k) in v {
+                    if k.terms().corners {
+                        let m = k.hessian_sparsity();
+                        acc.add_scaled_masked(*w, &k.corners_hessian(s), &m);
+                    }
+                }
+                acc
+            }
+            Kernel2::CellWeighted(w, k) => {
+                let mut acc = LanePartials::default();
+                let m = k.hessian_sparsity();
+                acc.add_scaled_masked(
+                    w.get(s.cell).copied().unwrap_or(1.0),
+                    &k.corners_hessian(s),
+                    &m,
+                );
+                acc
+            }
+            Kernel2::Custom(k) => k.corners_hessian(s),
+            leaf => kernel2_leaf!(leaf, k => k.corners_hessian(s), LanePartials::default()),
+        }
+    }
+    fn as_kernel2(&self) -> Option<&Kernel2> {
+        Some(self)
+    }
+}
+
+impl Kernel2 {
+    /// The kernel as a flat weighted sum `Σ wᵢ Kᵢ` with no nested [`Kernel2::Combination`]
+    /// (weights of nested combinations multiplied out). Equal to
+    /// `self` up to rounding (`w₁(w₂f)` becomes `(w₁w₂)f`). Used once per functional by the
+    /// evaluator to pick a monomorphized fused kernel for common sums (e.g. seed 000 (6.8)
+    /// `(1−σ)F_AO + σH_ω`, see [`crate::quad`]).
+    pub fn flattened(&self) -> Vec<(f64, Kernel2)> {
+        let mut out = Vec::new();
+        self.flatten_into(1.0, &mut out);
+        out
+    }
+
+    fn flatten_into(&self, w: f64, out: &mut Vec<(f64, Kernel2)>) {
+        match self {
+            Kernel2::Combination(v) => {
+                for (wi, k) in v {
+                    k.flatten_into(w * wi, out);
+                }
+            }
+            k => out.push((w, k.clone())),
         }
     }
 }

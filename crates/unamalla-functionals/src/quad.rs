@@ -18,8 +18,22 @@
 //!
 //! This one exact path serves every kernel (seed 001 digest §2.4 derivative kit, checked against
 //! finite differences in the tests).
+//!
+//! # Two implementations of the same formulas
+//! [`Problem`] for [`QuadFunctional`] runs the fast evaluator of the private `lanes` submodule
+//! (the four corners of a cell as SIMD lanes, per-cell first-contribution flags and CSR slot
+//! tables, AVX2 dispatch; its docs give the node-block formulas `H_PP = A + B + Bᵀ + C`,
+//! `H_PQ = −(A + Bᵀ)`, `H_PR = −(B + C)`, `H_QR = B` of a corner with leg blocks
+//! `A = H_aa`, `B = H_ab`, `C = H_bb`). The methods
+//! [`value_reference`](QuadFunctional::value_reference),
+//! [`value_grad_reference`](QuadFunctional::value_grad_reference),
+//! [`hessian_reference`](QuadFunctional::hessian_reference) and
+//! [`hess_vec_reference`](QuadFunctional::hess_vec_reference) keep the per-triangle path above;
+//! the two agree to rounding (`tests/fast_path.rs`). A run-time [`Kernel2`] is flattened once
+//! ([`Kernel2::flattened`]); `w₁F_AO + w₂H_ω` (seed 000 (6.8)) then runs the monomorphized
+//! `Sum<AreaOrthogonality, HOmega>` kernel, anything else one `match` per cell and term.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec2;
 use rayon::prelude::*;
@@ -28,8 +42,13 @@ use unamalla_mesh::{FreeNodes, HasQuadCells};
 use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
 use crate::csr::Csr;
 use crate::error::FunctionalError;
-use crate::kernels2::{Order, Terms, TriKernel, TriScalars};
+use crate::kernels2::{
+    AreaOrthogonality, CornerLanes, HOmega, Kernel2, LaneGrad, LanePartials, Order, Partials, Sum,
+    Terms, TriKernel, TriScalars,
+};
 use crate::problem::{LocalModel, Problem};
+
+mod lanes;
 
 /// Leg nodes `(n₀, n₁, n₂, n₃)` of corner `k` (`a = X_{n₁} − X_{n₀}`, `b = X_{n₃} − X_{n₂}`) and,
 /// at index 4, of the diagonal pair.
@@ -63,6 +82,16 @@ pub struct QuadTopology {
     asm: Assembly<4>,
     base: Vec<DVec2>,
     alpha_bar: f64,
+    /// Per cell, bit `i`: the contribution of vertex `i` is the first to reach its gradient
+    /// entries in the schedule order (store, don't add; see [`lanes`]).
+    gfirst: Vec<u8>,
+    /// Free variable nodes in no cell (their gradient entries are zeroed explicitly).
+    isolated: Vec<u32>,
+    /// Per cell, entry `4i + j`: position of vertex `j` in the neighbour list of vertex `i`
+    /// (the CSR slot of block `(i, j)`), with [`lanes::SLOT_FIRST`] on the first contribution;
+    /// built on the first Hessian refresh. `None` if a neighbour list is too long for `u16`
+    /// (the reference assembly is used then).
+    slots: OnceLock<Option<Vec<[u16; 16]>>>,
 }
 
 impl QuadTopology {
@@ -102,10 +131,27 @@ impl QuadTopology {
             return Err(FunctionalError::NonFinite { node: v });
         }
         let asm = Assembly::new(nodes.len(), cells, |v| fixed[v])?;
+        // first-contribution flags of the gradient, in schedule order
+        let mut seen = vec![false; asm.free.len()];
+        let mut gfirst = vec![0u8; asm.num_cells()];
+        for c in asm.schedule() {
+            for (i, &sv) in asm.src[c].iter().enumerate() {
+                if sv & FIXED_BIT == 0 && !seen[sv as usize] {
+                    seen[sv as usize] = true;
+                    gfirst[c] |= 1 << i;
+                }
+            }
+        }
+        let isolated = (0..asm.free.len() as u32)
+            .filter(|&j| !seen[j as usize])
+            .collect();
         let mut t = Self {
             asm,
             base: nodes,
             alpha_bar: 0.0,
+            gfirst,
+            isolated,
+            slots: OnceLock::new(),
         };
         let x = t.initial_x();
         t.alpha_bar = t.alpha_summary(&x).mean;
@@ -319,6 +365,96 @@ impl QuadTopology {
     pub fn hessian_pattern(&self) -> Csr {
         Csr::from_block_pattern(2, &self.asm.nbr_offsets, &self.asm.nbr)
     }
+
+    /// The per-cell Hessian slot table (built once, in schedule order for the first flags).
+    fn hessian_slots(&self) -> Option<&[[u16; 16]]> {
+        self.slots
+            .get_or_init(|| {
+                let asm = &self.asm;
+                let mut seen = vec![false; asm.nbr.len()];
+                let mut slots = vec![[0u16; 16]; asm.num_cells()];
+                for c in asm.schedule() {
+                    let src = asm.src[c];
+                    for i in 0..4 {
+                        if src[i] & FIXED_BIT != 0 {
+                            continue;
+                        }
+                        for j in 0..4 {
+                            if src[j] & FIXED_BIT != 0 {
+                                continue;
+                            }
+                            let k = asm.nbr_pos(src[i], src[j]);
+                            if k > lanes::SLOT_MAX {
+                                return None;
+                            }
+                            let b = asm.nbr_offsets[src[i] as usize] + k;
+                            let mut e = k as u16;
+                            if !seen[b] {
+                                seen[b] = true;
+                                e |= lanes::SLOT_FIRST;
+                            }
+                            slots[c][4 * i + j] = e;
+                        }
+                    }
+                }
+                Some(slots)
+            })
+            .as_deref()
+    }
+
+    /// Zeroes the entries of free nodes that belong to no cell (the fast paths never write them).
+    fn zero_isolated(&self, g: &mut [f64]) {
+        for &j in &self.isolated {
+            g[2 * j as usize] = 0.0;
+            g[2 * j as usize + 1] = 0.0;
+        }
+    }
+}
+
+/// Leg Hessian `H_u = Jᵀ (∂²f/∂s²) J + Σ_s f_s ∇²_u s`, `u = (aₓ, a_y, bₓ, b_y)` (module docs).
+#[inline(always)]
+fn leg_hessian(a: DVec2, b: DVec2, d: &Partials) -> [[f64; 4]; 4] {
+    // J = ∂s/∂u, u = (ax, ay, bx, by)
+    let j = [
+        [b.y, -b.x, -a.y, a.x],
+        [2.0 * a.x, 2.0 * a.y, 0.0, 0.0],
+        [0.0, 0.0, 2.0 * b.x, 2.0 * b.y],
+        [b.x, b.y, a.x, a.y],
+    ];
+    let mut hj = [[0.0; 4]; 4]; // (∂²f/∂s²) J
+    for si in 0..4 {
+        for ui in 0..4 {
+            let mut acc = 0.0;
+            for tt in 0..4 {
+                acc += d.h[si][tt] * j[tt][ui];
+            }
+            hj[si][ui] = acc;
+        }
+    }
+    let mut hu = [[0.0; 4]; 4];
+    for ui in 0..4 {
+        for uj in 0..4 {
+            let mut acc = 0.0;
+            for si in 0..4 {
+                acc += j[si][ui] * hj[si][uj];
+            }
+            hu[ui][uj] = acc;
+        }
+    }
+    let (ga_, gla, glb, go) = (d.g[0], d.g[1], d.g[2], d.g[3]);
+    hu[0][3] += ga_;
+    hu[3][0] += ga_;
+    hu[1][2] -= ga_;
+    hu[2][1] -= ga_;
+    hu[0][0] += 2.0 * gla;
+    hu[1][1] += 2.0 * gla;
+    hu[2][2] += 2.0 * glb;
+    hu[3][3] += 2.0 * glb;
+    hu[0][2] += go;
+    hu[2][0] += go;
+    hu[1][3] += go;
+    hu[3][1] += go;
+    hu
 }
 
 #[inline(always)]
@@ -470,46 +606,7 @@ fn cell_hess<K: TriKernel>(
         g[l[0]] -= ga;
         g[l[3]] += gb;
         g[l[2]] -= gb;
-        // J = ∂s/∂u, u = (ax, ay, bx, by)
-        let j = [
-            [b.y, -b.x, -a.y, a.x],
-            [2.0 * a.x, 2.0 * a.y, 0.0, 0.0],
-            [0.0, 0.0, 2.0 * b.x, 2.0 * b.y],
-            [b.x, b.y, a.x, a.y],
-        ];
-        let mut hj = [[0.0; 4]; 4]; // (∂²f/∂s²) J
-        for si in 0..4 {
-            for ui in 0..4 {
-                let mut acc = 0.0;
-                for tt in 0..4 {
-                    acc += d.h[si][tt] * j[tt][ui];
-                }
-                hj[si][ui] = acc;
-            }
-        }
-        let mut hu = [[0.0; 4]; 4];
-        for ui in 0..4 {
-            for uj in 0..4 {
-                let mut acc = 0.0;
-                for si in 0..4 {
-                    acc += j[si][ui] * hj[si][uj];
-                }
-                hu[ui][uj] = acc;
-            }
-        }
-        let (ga_, gla, glb, go) = (d.g[0], d.g[1], d.g[2], d.g[3]);
-        hu[0][3] += ga_;
-        hu[3][0] += ga_;
-        hu[1][2] -= ga_;
-        hu[2][1] -= ga_;
-        hu[0][0] += 2.0 * gla;
-        hu[1][1] += 2.0 * gla;
-        hu[2][2] += 2.0 * glb;
-        hu[3][3] += 2.0 * glb;
-        hu[0][2] += go;
-        hu[2][0] += go;
-        hu[1][3] += go;
-        hu[3][1] += go;
+        let hu = leg_hessian(a, b, &d);
         // (node, sign, leg)
         let ends = [
             (l[1], 1.0, 0usize),
@@ -531,22 +628,186 @@ fn cell_hess<K: TriKernel>(
     v
 }
 
+/// A run-time [`Kernel2`] flattened to `Σ wᵢ Kᵢ` ([`Kernel2::flattened`]): one `match` per
+/// cell and term instead of one per corner triangle and nesting level.
+#[derive(Debug, Clone)]
+struct FlatKernel {
+    /// `(wᵢ, Kᵢ, Kᵢ uses corner triangles)`.
+    items: Vec<(f64, Kernel2, bool)>,
+    terms: Terms,
+    sparsity: [[bool; 4]; 4],
+}
+
+impl FlatKernel {
+    fn new(items: Vec<(f64, Kernel2)>) -> Self {
+        let mut terms = Terms {
+            corners: false,
+            diagonal: false,
+        };
+        let items = items
+            .into_iter()
+            .map(|(w, k)| {
+                let t = k.terms();
+                terms = terms.or(t);
+                (w, k, t.corners)
+            })
+            .collect::<Vec<_>>();
+        let sparsity = items.iter().fold([[false; 4]; 4], |m, (_, k, _)| {
+            crate::kernels2::sparsity_or(m, k.hessian_sparsity())
+        });
+        Self {
+            items,
+            terms,
+            sparsity,
+        }
+    }
+}
+
+impl TriKernel for FlatKernel {
+    fn eval(&self, s: &TriScalars, order: Order) -> Partials {
+        let mut p = Partials::default();
+        for (w, k, _) in &self.items {
+            let t = k.terms();
+            if (s.corner == crate::kernels2::DIAGONAL && t.diagonal)
+                || (s.corner != crate::kernels2::DIAGONAL && t.corners)
+            {
+                p.add_scaled(*w, &k.eval(s, order), order);
+            }
+        }
+        p
+    }
+    fn terms(&self) -> Terms {
+        self.terms
+    }
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        self.sparsity
+    }
+    #[inline(always)]
+    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
+        let mut acc = [0.0; 4];
+        for (w, k, corners) in &self.items {
+            if *corners {
+                let v = k.corners_value(s);
+                for q in 0..4 {
+                    acc[q] += w * v[q];
+                }
+            }
+        }
+        acc
+    }
+    #[inline(always)]
+    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
+        let mut acc = LaneGrad::default();
+        for (w, k, corners) in &self.items {
+            if *corners {
+                acc.add_scaled(*w, &k.corners_value_grad(s));
+            }
+        }
+        acc
+    }
+    #[inline(always)]
+    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
+        let mut acc = LanePartials::default();
+        for (w, k, corners) in &self.items {
+            if *corners {
+                let m = k.hessian_sparsity();
+                acc.add_scaled_masked(*w, &k.corners_hessian(s), &m);
+            }
+        }
+        acc
+    }
+}
+
+/// How the fast path evaluates the kernel of a [`QuadFunctional`].
+#[derive(Debug, Clone)]
+enum Plan {
+    /// The kernel itself, monomorphized.
+    Own,
+    /// A run-time [`Kernel2`] that flattens to `w₁F_AO + w₂H_ω` (seed 000 (6.8)): evaluated by
+    /// the monomorphized fused kernel.
+    AoHOmega(Sum<AreaOrthogonality, HOmega>),
+    /// Any other run-time [`Kernel2`], flattened.
+    Flat(FlatKernel),
+}
+
+impl Plan {
+    fn for_kernel<K: TriKernel>(kernel: &K) -> Plan {
+        let Some(k2) = kernel.as_kernel2() else {
+            return Plan::Own;
+        };
+        let flat = k2.flattened();
+        if let [(w1, k1), (w2, k2)] = flat.as_slice() {
+            match (k1, k2) {
+                (Kernel2::AreaOrthogonality, Kernel2::HOmega(h)) => {
+                    return Plan::AoHOmega(Sum {
+                        wa: *w1,
+                        a: AreaOrthogonality,
+                        wb: *w2,
+                        b: *h,
+                    })
+                }
+                (Kernel2::HOmega(h), Kernel2::AreaOrthogonality) => {
+                    return Plan::AoHOmega(Sum {
+                        wa: *w2,
+                        a: AreaOrthogonality,
+                        wb: *w1,
+                        b: *h,
+                    })
+                }
+                _ => {}
+            }
+        }
+        Plan::Flat(FlatKernel::new(flat))
+    }
+}
+
+/// Runs `$body` with `$k` bound to the kernel the fast path uses (monomorphized per plan).
+macro_rules! with_plan {
+    ($self:expr, $k:ident, $t:ident => $body:expr) => {
+        match &$self.plan {
+            Plan::Own => {
+                let $k = &$self.kernel;
+                let $t = $self.terms;
+                $body
+            }
+            Plan::AoHOmega(kk) => {
+                let $k = kk;
+                let $t = kk.terms();
+                $body
+            }
+            Plan::Flat(kk) => {
+                let $k = kk;
+                let $t = kk.terms;
+                $body
+            }
+        }
+    };
+}
+
 /// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a per-term kernel.
+///
+/// [`Problem`] is implemented by the fast evaluator (module `lanes`: four corner lanes per cell,
+/// precomputed index and slot tables, AVX2 when available); the `*_reference` methods keep the
+/// straightforward per-triangle path, which the tests compare against.
 #[derive(Debug, Clone)]
 pub struct QuadFunctional<K> {
     topo: Arc<QuadTopology>,
     kernel: K,
     terms: Terms,
+    plan: Plan,
 }
 
 impl<K: TriKernel> QuadFunctional<K> {
     /// The functional `Σ kernel` over the leg pairs of the topology.
     pub fn new(topo: Arc<QuadTopology>, kernel: K) -> Self {
         let terms = kernel.terms();
+        let plan = Plan::for_kernel(&kernel);
         Self {
             topo,
             kernel,
             terms,
+            plan,
         }
     }
     /// The topology.
@@ -560,6 +821,7 @@ impl<K: TriKernel> QuadFunctional<K> {
     /// Replaces the kernel (e.g. a new ω or k during a continuation), keeping the topology.
     pub fn set_kernel(&mut self, kernel: K) {
         self.terms = kernel.terms();
+        self.plan = Plan::for_kernel(&kernel);
         self.kernel = kernel;
     }
     /// The value with a single-threaded loop (same chunked summation as [`Problem::value`], so
@@ -570,28 +832,14 @@ impl<K: TriKernel> QuadFunctional<K> {
             self.topo.num_vars(),
             "value: x has the wrong length"
         );
-        self.topo.asm.run_serial_sum(|c| {
-            let (p, _) = self.topo.cell_points(x, c);
-            cell_value(&self.kernel, self.terms, &p, c)
-        })
-    }
-}
-
-impl<K: TriKernel> Problem for QuadFunctional<K> {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_vars(&self) -> usize {
-        self.topo.num_vars()
-    }
-    fn free_nodes(&self) -> &[usize] {
-        self.topo.free_nodes()
-    }
-    fn var_of(&self, node: usize) -> Option<usize> {
-        self.topo.var_of(node)
+        with_plan!(self, k, t => self.topo.asm.run_serial_chunks(|s, e| {
+            lanes::value_chunk(&self.topo, k, t, x, s, e)
+        }))
     }
 
-    fn value(&self, x: &[f64]) -> f64 {
+    /// Reference value: the per-triangle path with the kernel as given (no lanes, no
+    /// flattening). Equal to [`Problem::value`] up to rounding.
+    pub fn value_reference(&self, x: &[f64]) -> f64 {
         assert_eq!(
             x.len(),
             self.topo.num_vars(),
@@ -603,7 +851,9 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
         })
     }
 
-    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
+    /// Reference value and gradient (per-triangle path, zero then add). Equal to
+    /// [`Problem::value_grad`] up to rounding.
+    pub fn value_grad_reference(&self, x: &[f64], g: &mut [f64]) -> f64 {
         assert_eq!(
             x.len(),
             self.topo.num_vars(),
@@ -635,11 +885,17 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
         })
     }
 
-    fn hessian_pattern(&self) -> Csr {
-        self.topo.hessian_pattern()
+    /// Reference Hessian refresh (per-triangle 8×8 cell matrices, zero then add, neighbour
+    /// positions found by binary search). Equal to [`Problem::hessian`] up to rounding.
+    ///
+    /// # Panics
+    /// As [`Problem::hessian`].
+    pub fn hessian_reference(&self, x: &[f64], h: &mut Csr) {
+        self.check_hessian_args(x, h);
+        self.hessian_generic(x, h);
     }
 
-    fn hessian(&self, x: &[f64], h: &mut Csr) {
+    fn check_hessian_args(&self, x: &[f64], h: &Csr) {
         assert_eq!(
             x.len(),
             self.topo.num_vars(),
@@ -654,6 +910,9 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
             self.topo.asm.matches_pattern(2, h),
             "hessian: matrix does not come from hessian_pattern"
         );
+    }
+
+    fn hessian_generic(&self, x: &[f64], h: &mut Csr) {
         let Csr {
             row_offsets,
             values,
@@ -696,7 +955,9 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
         });
     }
 
-    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+    /// Reference matrix-free Hessian-vector product (per-triangle 8×8 cell matrices). Equal to
+    /// [`Problem::hess_vec`] up to rounding.
+    pub fn hess_vec_reference(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
         let n = self.topo.num_vars();
         assert_eq!(x.len(), n, "hess_vec: x has the wrong length");
         assert_eq!(v.len(), n, "hess_vec: v has the wrong length");
@@ -733,7 +994,86 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
             0.0
         });
     }
+}
 
+impl<K: TriKernel> Problem for QuadFunctional<K> {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn num_vars(&self) -> usize {
+        self.topo.num_vars()
+    }
+    fn free_nodes(&self) -> &[usize] {
+        self.topo.free_nodes()
+    }
+    fn var_of(&self, node: usize) -> Option<usize> {
+        self.topo.var_of(node)
+    }
+
+    fn value(&self, x: &[f64]) -> f64 {
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "value: x has the wrong length"
+        );
+        with_plan!(self, k, t => self.topo.asm.run_value_chunks(|s, e| {
+            lanes::value_chunk(&self.topo, k, t, x, s, e)
+        }))
+    }
+
+    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
+        assert_eq!(
+            x.len(),
+            self.topo.num_vars(),
+            "value_grad: x has the wrong length"
+        );
+        assert_eq!(
+            g.len(),
+            self.topo.num_vars(),
+            "value_grad: g has the wrong length"
+        );
+        self.topo.zero_isolated(g);
+        let gp = SyncPtr::new(g);
+        with_plan!(self, k, t => self.topo.asm.run_colored_chunks(|s, e| {
+            lanes::grad_chunk(&self.topo, k, t, x, gp, s, e)
+        }))
+    }
+
+    fn hessian_pattern(&self) -> Csr {
+        self.topo.hessian_pattern()
+    }
+
+    fn hessian(&self, x: &[f64], h: &mut Csr) {
+        self.check_hessian_args(x, h);
+        let Some(slots) = self.topo.hessian_slots() else {
+            self.hessian_generic(x, h);
+            return;
+        };
+        let Csr {
+            row_offsets,
+            values,
+            ..
+        } = h;
+        let hp = SyncPtr::new(values);
+        let ro: &[usize] = row_offsets;
+        with_plan!(self, k, t => self.topo.asm.run_colored_chunks(|s, e| {
+            lanes::hess_chunk(&self.topo, k, t, x, slots, ro, hp, s, e);
+            0.0
+        }));
+    }
+
+    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+        let n = self.topo.num_vars();
+        assert_eq!(x.len(), n, "hess_vec: x has the wrong length");
+        assert_eq!(v.len(), n, "hess_vec: v has the wrong length");
+        assert_eq!(out.len(), n, "hess_vec: out has the wrong length");
+        self.topo.zero_isolated(out);
+        let op = SyncPtr::new(out);
+        with_plan!(self, k, t => self.topo.asm.run_colored_chunks(|s, e| {
+            lanes::hess_vec_chunk(&self.topo, k, t, x, v, op, s, e);
+            0.0
+        }));
+    }
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         self.topo.var_of(node)?;
         assert_eq!(

@@ -319,12 +319,14 @@ pub enum IoError {
         reason: String,
     },
 
-    /// The `shapefile` crate rejected the file.
+    /// The file is not a shapefile (its first four bytes are not the file code 9994), or a
+    /// region is too large for a shapefile record; structural problems of a `.shp` file are
+    /// [`IoError::MalformedBinary`] with the byte offset (see [`crate::shp`]).
     #[error("{}: shapefile: {message}", .path.display())]
     Shapefile {
         /// The file.
         path: PathBuf,
-        /// What the `shapefile` crate reported.
+        /// What is wrong.
         message: String,
     },
 }

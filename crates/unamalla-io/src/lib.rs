@@ -46,7 +46,7 @@
 //!
 //! Every function returns [`IoError`]. Errors caused by file content carry the file path (or
 //! `<string>` for text parsed from memory) and a 1-based line number (text formats, malformed
-//! JSON), a byte offset (binary Plot3D), the `shapefile` crate's message (Shapefile) or a JSON path (well-formed JSON with the wrong
+//! JSON), a byte offset (binary Plot3D, Shapefile) or a JSON path (well-formed JSON with the wrong
 //! content). No function panics on any input.
 //!
 //! ## Atomic writes
@@ -126,7 +126,8 @@ pub use rings::{
     parse_region_text, parse_rings_text, read_region_text, read_rings_text, write_region_text,
 };
 pub use shp::{
-    parse_shapefile_parts, read_region_shapefile, read_shapefile_parts, write_region_shapefile,
+    encode_region_shapefile, parse_shapefile_parts, read_region_shapefile, read_shapefile_parts,
+    write_region_shapefile,
 };
 pub use surface::{
     parse_obj, parse_off, read_obj, read_off, write_obj_hexes, write_obj_quads, write_off_hexes,

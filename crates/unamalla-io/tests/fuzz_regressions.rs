@@ -95,3 +95,25 @@ fn shapefile_padded_null_shape_is_an_error() {
         other => panic!("expected MalformedBinary, got {other:?}"),
     }
 }
+
+/// `shapefile` target, fourth 10-minute run (out of memory inside the `shapefile` crate, input
+/// `fuzz/artifacts/shapefile/oom-8bb556…`, 324 bytes): the header declares 0x0500_0000 words;
+/// the polygon record at byte 100 declares 212 bytes of content but has 0 parts and 10 points,
+/// i.e. 44 + 16·10 = 204 bytes of data and 8 bytes of padding. The crate read on from the end
+/// of the data (not from the declared end of the record), took the padding and the next bytes
+/// for a record header and reserved gigabytes. Our own parser (since issue #14 the `shapefile`
+/// crate is no longer used) moves by the declared length to byte 100 + 8 + 212 = 320, where
+/// the next record header (8 bytes) does not fit in the 324-byte file.
+#[test]
+fn shapefile_record_padding_is_skipped_by_declared_length() {
+    let bytes = include_bytes!("data/fuzz/shapefile-oom-fourth-run.shp");
+    match parse_shapefile_parts(bytes) {
+        Err(IoError::MalformedBinary {
+            offset, message, ..
+        }) => {
+            assert_eq!(offset, 320, "{message}");
+            assert!(message.contains("end of the file"), "{message}");
+        }
+        other => panic!("expected MalformedBinary, got {other:?}"),
+    }
+}

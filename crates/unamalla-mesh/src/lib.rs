@@ -12,6 +12,9 @@
 //! * α (triangle measure) is the doubled signed area `det(Q − P, R − P)`.
 
 #![warn(missing_docs)]
+// No unwrap/expect in library code: user input must give an error, never a panic (issue #10/#14).
+// Tests and doc examples may use them.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod block;
 pub mod error;

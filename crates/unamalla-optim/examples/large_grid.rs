@@ -1,17 +1,28 @@
-//! Untangle + smooth ((6.8), ε = 0.01) the TFI grid of the sinusoidal four-sided region with
-//! each solver, directly and coarse-to-fine (refine ×3 per level, boundary reset to the exact
-//! fine boundary). Prints a Markdown table.
+//! Untangle + smooth ((6.8), ε = 0.01) the TFI grid of the sinusoidal four-sided region, directly
+//! from the TFI grid and/or coarse-to-fine ([`smooth_coarse_to_fine`], ratio 3), and print a
+//! Markdown table.
 //!
-//! `cargo run --release -p unamalla-optim --example large_grid -- 100,300,1000 [solvers]`
-//! (sizes are nodes per side; solvers default to all four, e.g. `tn-tr,lbfgs`; a third
-//! argument `c2f` runs only the coarse-to-fine variant).
+//! `cargo run --release -p unamalla-optim --example large_grid -- SIZES [SOLVERS] [MODE] [PRECOND]`
+//! * `SIZES`: nodes per side, e.g. `100,301,1000`;
+//! * `SOLVERS`: e.g. `tn-tr,tn-ls` (default all four);
+//! * `MODE`: `direct`, `c2f` or `both` (default `both`; coarse-to-fine needs `(n−1)` divisible
+//!   by 3 with a coarse level of at least 30 nodes);
+//! * `PRECOND`: the CG preconditioner of truncated Newton, `multigrid` (default) or
+//!   `block-jacobi`, `jacobi`, `none`.
+//!
+//! Tolerance (the same for every size, so the scaling is comparable): the run stops when the
+//! relative decrease of F in a step is at most FTOL = 1e-9 (`(F_old − F) ≤ 1e-9·F`; near the
+//! optimum Newton's decrease approximates `F_old − F*`); GTOL is off; MAXITER 500. The coarse
+//! levels of coarse-to-fine stop at FTOL 1e-6.
 
 use std::time::Instant;
 
-use unamalla_functionals::QuadTopology;
 use unamalla_mesh::StructuredGrid2;
 use unamalla_optim::fixtures::sinusoidal;
-use unamalla_optim::{smooth, NullObserver, SmoothOptions, SmoothReport, Solver, SolverOptions};
+use unamalla_optim::{
+    smooth, smooth_coarse_to_fine, CoarseToFineOptions, NullObserver, Preconditioner,
+    SmoothOptions, Solver, SolverOptions,
+};
 
 const AMP: f64 = 0.1;
 const WAVES: f64 = 2.0;
@@ -20,58 +31,18 @@ fn region(n: usize) -> StructuredGrid2 {
     sinusoidal(n, n, AMP, WAVES).expect("region")
 }
 
-fn run(g: &mut StructuredGrid2, solver: Solver) -> SmoothReport {
-    let opts = SmoothOptions {
+/// The benchmark's options (see the module docs for the tolerance).
+fn options(solver: Solver, pre: Preconditioner) -> SmoothOptions {
+    SmoothOptions {
         solver: SolverOptions {
             max_iter: 500,
+            ftol: 1e-9,
+            gtol: 0.0,
+            preconditioner: pre,
             ..SolverOptions::new(solver)
         },
         ..SmoothOptions::default()
-    };
-    smooth(g, &opts, &mut NullObserver).expect("smooth")
-}
-
-/// Coarse-to-fine: solve on `(n−1)/3ᵏ + 1` nodes, refine ×3, reset the boundary, repeat.
-fn coarse_to_fine(n: usize, solver: Solver) -> (StructuredGrid2, usize, f64) {
-    let mut levels = vec![n];
-    while (levels[levels.len() - 1] - 1) % 3 == 0 && (levels[levels.len() - 1] - 1) / 3 >= 60 {
-        let l = levels[levels.len() - 1];
-        levels.push((l - 1) / 3 + 1);
     }
-    levels.reverse();
-    let mut g = region(levels[0]);
-    let mut it = 0;
-    let r0 = run(&mut g, solver);
-    eprintln!(
-        "level {}: {:.3}s, {} it",
-        levels[0],
-        r0.elapsed.as_secs_f64(),
-        r0.iterations()
-    );
-    for &l in &levels[1..] {
-        let mut f = g.refined(2, 2).expect("refine");
-        let exact = region(l);
-        for j in 0..l {
-            for i in 0..l {
-                if exact.is_boundary(i, j) {
-                    f.set_node(i, j, exact.node(i, j));
-                }
-            }
-        }
-        let r = run(&mut f, solver);
-        eprintln!(
-            "level {l}: {:.3}s, {} it, initial Inocon {}, {}",
-            r.elapsed.as_secs_f64(),
-            r.iterations(),
-            r.initial_inocon,
-            r.status
-        );
-        it += r.iterations();
-        g = f;
-    }
-    let t = QuadTopology::from_mesh(&g).expect("topology");
-    let s = t.alpha_summary(&t.initial_x());
-    (g, it, s.min / s.mean)
 }
 
 fn main() {
@@ -79,37 +50,76 @@ fn main() {
     let sizes: Vec<usize> = args
         .get(1)
         .map(|s| s.split(',').map(|v| v.parse().expect("size")).collect())
-        .unwrap_or_else(|| vec![100, 300]);
+        .unwrap_or_else(|| vec![100, 301]);
     let solvers: Vec<Solver> = args
         .get(2)
         .map(|s| s.split(',').map(|v| v.parse().expect("solver")).collect())
         .unwrap_or_else(|| Solver::ALL.to_vec());
-    let c2f_only = args.get(3).is_some_and(|a| a == "c2f");
-    println!("| nodes | solver | start | initial Inocon | iterations | time [s] | final α₋/ᾱ | F | status |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    let mode = args.get(3).map_or("both", String::as_str);
+    let pre: Preconditioner = args.get(4).map_or(Preconditioner::Multigrid, |s| {
+        s.parse().expect("preconditioner")
+    });
+    println!(
+        "| nodes | solver | preconditioner | start | iterations | CG iterations | time [s] | final α₋/ᾱ | F | status |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for &n in &sizes {
         for &s in &solvers {
-            let mut g = region(n);
-            let t0 = Instant::now();
-            let r = if c2f_only { None } else { Some(run(&mut g, s)) };
-            if let Some(r) = r {
+            let opts = options(s, pre);
+            let pname = if matches!(s, Solver::TnTr | Solver::TnLs) {
+                pre.name()
+            } else {
+                "–"
+            };
+            if mode != "c2f" {
+                let mut g = region(n);
+                let t0 = Instant::now();
+                let r = smooth(&mut g, &opts, &mut NullObserver).expect("smooth");
                 println!(
-                    "| {n}² | {s} | TFI | {} | {} | {:.3} | {:.4} | {:.6} | {} |",
-                    r.initial_inocon,
+                    "| {n}² | {s} | {pname} | TFI | {} | {} | {:.3} | {:.4} | {:.6} | {} |",
                     r.iterations(),
+                    r.cg_iterations,
                     t0.elapsed().as_secs_f64(),
                     r.alfamin_rel(),
                     r.f,
                     r.status
                 );
             }
-            if (n - 1) % 3 == 0 && (n - 1) / 3 >= 60 {
+            if mode != "direct" {
+                let co = CoarseToFineOptions {
+                    smooth: opts.clone(),
+                    ..CoarseToFineOptions::default()
+                };
+                let mut g = region(n);
                 let t0 = Instant::now();
-                let (_, it, m) = coarse_to_fine(n, s);
-                println!(
-                    "| {n}² | {s} | coarse-to-fine | – | {it} (finest levels) | {:.3} | {m:.4} | – | – |",
-                    t0.elapsed().as_secs_f64()
-                );
+                let rep = smooth_coarse_to_fine(&mut g, &co, &mut NullObserver).expect("c2f");
+                let total = t0.elapsed().as_secs_f64();
+                let mut its = Vec::new();
+                for l in &rep.levels {
+                    eprintln!(
+                        "  level {}²: start α₋/ᾱ {:.4}{}, {} it, {} CG, {:.3} s, {}",
+                        l.m,
+                        l.start_alfamin_rel,
+                        if l.restarted { " (restarted)" } else { "" },
+                        l.report.iterations(),
+                        l.report.cg_iterations,
+                        l.report.elapsed.as_secs_f64(),
+                        l.report.status
+                    );
+                    its.push(format!("{}", l.report.iterations()));
+                }
+                if let Some(f) = rep.fine() {
+                    println!(
+                        "| {n}² | {s} | {pname} | coarse-to-fine ({}) | {} | {} (finest) | {total:.3} | {:.4} | {:.6} | {}{} |",
+                        rep.levels.iter().map(|l| format!("{}²", l.m)).collect::<Vec<_>>().join(" → "),
+                        its.join(" + "),
+                        f.cg_iterations,
+                        f.alfamin_rel(),
+                        f.f,
+                        f.status,
+                        if rep.fallback { " (fallback)" } else { "" }
+                    );
+                }
             }
         }
     }

@@ -1,6 +1,6 @@
 //! Smooths the sinusoidal region with one solver and a live progress line (diagnostics).
 //!
-//! `cargo run --release -p unamalla-optim --example smooth_one -- 300 tn-tr [none|jacobi|block-jacobi]`
+//! `cargo run --release -p unamalla-optim --example smooth_one -- 300 tn-tr [none|jacobi|block-jacobi|multigrid]`
 
 use std::time::Instant;
 
@@ -15,11 +15,9 @@ fn main() {
     let s: Solver = args
         .get(2)
         .map_or(Solver::TnTr, |s| s.parse().expect("solver"));
-    let pre = match args.get(3).map(String::as_str) {
-        Some("none") => Preconditioner::None,
-        Some("jacobi") => Preconditioner::Jacobi,
-        _ => Preconditioner::BlockJacobi,
-    };
+    let pre: Preconditioner = args.get(3).map_or(Preconditioner::BlockJacobi, |s| {
+        s.parse().expect("preconditioner")
+    });
     let mut g = sinusoidal(n, n, 0.1, 2.0).expect("region");
     let mut obs = ProgressObserver::default();
     let t = Instant::now();
@@ -34,9 +32,10 @@ fn main() {
     let r = smooth(&mut g, &opts, &mut obs).expect("smooth");
     obs.finish();
     println!(
-        "{n}² {s} {pre:?}: {:.3}s, {} it, α₋/ᾱ {:.4}, F {:.6}, {}",
+        "{n}² {s} {pre:?}: {:.3}s, {} it, {} CG it (last run), α₋/ᾱ {:.4}, F {:.6}, {}",
         t.elapsed().as_secs_f64(),
         r.iterations(),
+        r.cg_iterations,
         r.alfamin_rel(),
         r.f,
         r.status

@@ -202,6 +202,9 @@ pub struct SmoothReport {
     /// start, except the iteration counters and the time).
     #[serde(default)]
     pub restored: bool,
+    /// Inner CG iterations of the last solver run (truncated Newton; 0 for the others).
+    #[serde(default)]
+    pub cg_iterations: usize,
 }
 
 impl SmoothReport {
@@ -316,6 +319,7 @@ fn report(
         planarity: None,
         elapsed: session.elapsed(),
         restored: false,
+        cg_iterations: last.map_or(0, |r| r.cg_iterations),
     }
 }
 

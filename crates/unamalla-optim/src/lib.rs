@@ -22,8 +22,10 @@
 //!   colour is updated in parallel and the result equals a sequential sweep in colour order.
 //!
 //! Preconditioners ([`linalg::Preconditioner`]): none, Jacobi, block-Jacobi (node blocks of
-//! the assembled CSR Hessian; default). Hessian products use the assembled CSR matrix
-//! (refreshed once per outer iteration) or matrix-free `Problem::hess_vec`.
+//! the assembled CSR Hessian; default), and a smoothed-aggregation multigrid V-cycle
+//! ([`multigrid`]) whose CG iteration count grows only slowly with the grid size. Hessian
+//! products use the assembled CSR matrix (refreshed once per outer iteration) or matrix-free
+//! `Problem::hess_vec`.
 //!
 //! **Why not `argmin`.** The solvers are written here, not taken from `argmin` 0.11, for
 //! correctness reasons: every trial point must pass the convexity safeguard below (argmin's
@@ -67,22 +69,29 @@
 //! * [`smooth`] / [`smooth_hex`]: the entry points used by `unamalla smooth`; they never return
 //!   more non-convex cells than they were given ([`SmoothReport::restored`]).
 //! * [`smooth_each`]: independent meshes (the blocks before merging) in parallel.
+//! * [`smooth_coarse_to_fine`] ([`coarse_to_fine`]): one structured grid solved on coarser
+//!   grids of the same region first (subsampled start, bilinear prolongation, exact boundary
+//!   put back by a transfinite correction, repair), then finished on the fine grid.
 //!
 //! ## Fixtures ([`fixtures`])
 //! The seed 001 §5 test regions (`cuad2pp`, the one-hole contour, Ivanenko's region) as TFI
 //! grids, and the sinusoidal benchmark region.
 
 #![warn(missing_docs)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod coarse_to_fine;
 pub mod drivers;
 pub mod error;
 pub mod fixtures;
 pub mod linalg;
 pub mod linesearch;
 pub mod monitor;
+pub mod multigrid;
 pub mod solver;
 pub mod status;
 
+pub use coarse_to_fine::{smooth_coarse_to_fine, CoarseToFineOptions, CoarseToFineReport};
 pub use drivers::{
     smooth, smooth_each, smooth_hex, HexDriver, HexSmoothOptions, KFunctional, SmoothFunctional,
     SmoothOptions, SmoothReport,

@@ -3,6 +3,8 @@
 use rayon::prelude::*;
 use unamalla_functionals::Csr;
 
+use crate::multigrid::{Multigrid, MultigridOptions};
+
 const PAR: usize = 1 << 15;
 
 /// `xᵀy`.
@@ -87,14 +89,54 @@ pub enum Preconditioner {
     /// `diag(|H_ii|)` on a block that is not positive definite).
     #[default]
     BlockJacobi,
+    /// One symmetric V-cycle of smoothed-aggregation algebraic multigrid
+    /// ([`Multigrid`], default [`MultigridOptions`]) built from
+    /// the assembled Hessian; its iteration count does not grow with the grid size.
+    Multigrid,
 }
 
-/// An applied preconditioner: `M⁻¹` stored per node block (`dim²` entries per node).
+impl Preconditioner {
+    /// All preconditioners.
+    pub const ALL: [Preconditioner; 4] = [
+        Preconditioner::None,
+        Preconditioner::Jacobi,
+        Preconditioner::BlockJacobi,
+        Preconditioner::Multigrid,
+    ];
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preconditioner::None => "none",
+            Preconditioner::Jacobi => "jacobi",
+            Preconditioner::BlockJacobi => "block-jacobi",
+            Preconditioner::Multigrid => "multigrid",
+        }
+    }
+}
+
+impl std::str::FromStr for Preconditioner {
+    type Err = crate::OptimError;
+    fn from_str(s: &str) -> Result<Self, crate::OptimError> {
+        Preconditioner::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| crate::OptimError::UnknownName {
+                what: "preconditioner",
+                name: s.to_string(),
+                expected: "none, jacobi, block-jacobi, multigrid",
+            })
+    }
+}
+
+/// An applied preconditioner: `M⁻¹` stored per node block (`dim²` entries per node), and for
+/// [`Preconditioner::Multigrid`] the multigrid hierarchy (its node-block inverses are kept too:
+/// [`apply`](Self::apply) without the matrix falls back to block-Jacobi).
 #[derive(Debug, Clone, Default)]
 pub struct PrecondApply {
     dim: usize,
     inv: Vec<f64>,
     kind: Option<Preconditioner>,
+    mg: Option<Box<Multigrid>>,
 }
 
 impl PrecondApply {
@@ -114,8 +156,19 @@ impl PrecondApply {
             (m * 1e-12).max(f64::MIN_POSITIVE)
         };
         let jac = |r: usize| 1.0 / h.get(r, r).abs().max(floor);
+        if kind == Preconditioner::Multigrid {
+            self.build(Preconditioner::BlockJacobi, h, dim);
+            self.kind = Some(kind);
+            self.mg = Some(Box::new(Multigrid::build(
+                h,
+                dim,
+                &MultigridOptions::default(),
+            )));
+            return;
+        }
+        self.mg = None;
         match kind {
-            Preconditioner::None => {}
+            Preconditioner::None | Preconditioner::Multigrid => {}
             Preconditioner::Jacobi => {
                 self.inv.par_chunks_mut(d2).enumerate().for_each(|(b, m)| {
                     m.iter_mut().for_each(|v| *v = 0.0);
@@ -175,7 +228,48 @@ impl PrecondApply {
         }
     }
 
-    /// `z = M⁻¹ r`.
+    /// The inverse of node block `b` (`dim²` entries, row-major; all zeros for
+    /// [`Preconditioner::None`]).
+    pub fn block(&self, b: usize) -> &[f64] {
+        let d2 = self.dim * self.dim;
+        self.inv.get(b * d2..(b + 1) * d2).unwrap_or(&[])
+    }
+
+    /// Like [`build`](Self::build), but for [`Preconditioner::Multigrid`] with an existing
+    /// hierarchy of the same size and `rebuild_coarse == false`, only the node-block inverses
+    /// and the finest smoother are refreshed from `h` and the coarse levels are kept (lagged
+    /// from an earlier Hessian; the setup of the coarse levels costs several Hessian
+    /// refreshes on large grids).
+    pub fn update(&mut self, kind: Preconditioner, h: &Csr, dim: usize, rebuild_coarse: bool) {
+        if kind == Preconditioner::Multigrid && !rebuild_coarse {
+            if let Some(mut mg) = self.mg.take() {
+                if mg.refresh_finest(h) {
+                    self.build(Preconditioner::BlockJacobi, h, dim);
+                    self.kind = Some(kind);
+                    self.mg = Some(mg);
+                    return;
+                }
+            }
+        }
+        self.build(kind, h, dim);
+    }
+
+    /// The multigrid hierarchy, if the preconditioner is [`Preconditioner::Multigrid`].
+    pub fn multigrid(&self) -> Option<&Multigrid> {
+        self.mg.as_deref()
+    }
+
+    /// `z = M⁻¹ r` where `a` is the matrix the preconditioner was built from (needed by the
+    /// multigrid V-cycle; the other kinds ignore it).
+    pub fn apply_with(&self, a: &Csr, r: &[f64], z: &mut [f64]) {
+        match &self.mg {
+            Some(mg) if a.nrows == r.len() => mg.apply(a, r, z),
+            _ => self.apply(r, z),
+        }
+    }
+
+    /// `z = M⁻¹ r` (for [`Preconditioner::Multigrid`]: the block-Jacobi part only; use
+    /// [`apply_with`](Self::apply_with)).
     pub fn apply(&self, r: &[f64], z: &mut [f64]) {
         match self.kind {
             None | Some(Preconditioner::None) => z.copy_from_slice(r),

@@ -431,7 +431,7 @@ struct CgOut {
 fn steihaug(
     hv: &dyn Fn(&[f64], &mut [f64]),
     g: &[f64],
-    pre: &PrecondApply,
+    pre: &dyn Fn(&[f64], &mut [f64]),
     radius: f64,
     tol: f64,
     maxit: usize,
@@ -441,7 +441,7 @@ fn steihaug(
     z.iter_mut().for_each(|v| *v = 0.0);
     hz.iter_mut().for_each(|v| *v = 0.0);
     r.copy_from_slice(g);
-    pre.apply(r, y);
+    pre(r, y);
     d.iter_mut().zip(y.iter()).for_each(|(d, y)| *d = -y);
     let mut ry = dot(r, y);
     let (mut zmz, mut zmd, mut dmd) = (0.0, 0.0, ry);
@@ -492,8 +492,13 @@ fn steihaug(
         if norm(r) <= tol {
             break;
         }
-        pre.apply(r, y);
+        pre(r, y);
         let ry_new = dot(r, y);
+        if ry_new.is_nan() || ry_new <= 0.0 || !ry_new.is_finite() {
+            // the preconditioner is not positive definite on this residual (possible only for
+            // an indefinite Hessian): keep the current iterate
+            break;
+        }
         let beta = ry_new / ry;
         ry = ry_new;
         zmd = beta * (zmd + a * dmd);
@@ -560,10 +565,21 @@ fn truncated_newton<P: Problem + ?Sized>(
     let mut xt = vec![0.0; n];
     let mut gt = vec![0.0; n];
     let mut radius = f64::INFINITY;
+    // CG iterations of the last outer iteration, and of the first one after the last
+    // multigrid rebuild
+    let mut cg_last = 0usize;
+    let mut mg_built_cg: Option<usize> = None;
     let reason = 'outer: loop {
+        let cg_before = st.cg;
         if assembled {
             problem.hessian(x, &mut h);
-            pre.build(opts.preconditioner, &h, problem.dim());
+            // multigrid: the coarse levels are rebuilt only when CG needed clearly more
+            // iterations than right after the last rebuild (lagged hierarchy)
+            let rebuild = mg_built_cg.is_none_or(|c0| cg_last > (2 * c0).max(12));
+            pre.update(opts.preconditioner, &h, problem.dim(), rebuild);
+            if rebuild {
+                mg_built_cg = None;
+            }
         } else {
             pre.build(Preconditioner::None, &h, problem.dim());
         }
@@ -577,13 +593,15 @@ fn truncated_newton<P: Problem + ?Sized>(
                 problem.hess_vec(xr, v, out)
             }
         };
+        let hr: &Csr = &h;
+        let prec = |v: &[f64], out: &mut [f64]| pre.apply_with(hr, v, out);
         let guard = session.guard_active(st.cur_min);
         let f_acc;
         let mut truncated;
         if trust {
             loop {
                 truncated = false;
-                let mut o = steihaug(&hv, g, &pre, radius, tol, opts.cg_max_iter, &mut w);
+                let mut o = steihaug(&hv, g, &prec, radius, tol, opts.cg_max_iter, &mut w);
                 st.cg += o.iters;
                 if radius.is_infinite() {
                     radius = o.znorm_m.max(f64::MIN_POSITIVE);
@@ -633,7 +651,7 @@ fn truncated_newton<P: Problem + ?Sized>(
                 }
             }
         } else {
-            let o = steihaug(&hv, g, &pre, f64::INFINITY, tol, opts.cg_max_iter, &mut w);
+            let o = steihaug(&hv, g, &prec, f64::INFINITY, tol, opts.cg_max_iter, &mut w);
             st.cg += o.iters;
             let mut gd = dot(g, &w.z);
             if gd.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) {
@@ -675,6 +693,10 @@ fn truncated_newton<P: Problem + ?Sized>(
                 );
             }
             f_acc = r.f;
+        }
+        cg_last = st.cg - cg_before;
+        if mg_built_cg.is_none() {
+            mg_built_cg = Some(cg_last);
         }
         x.copy_from_slice(&xt);
         g.copy_from_slice(&gt);
@@ -892,8 +914,11 @@ fn pointwise<P: Problem + ?Sized>(
     let ok = matches!(&session.colors, Some(c) if c.iter().map(Vec::len).sum::<usize>() * dim == problem.num_vars());
     if !ok {
         ensure_hessian(problem, session);
-        let h = session.hess.as_ref().expect("pattern built above");
-        session.colors = Some(node_colors(h, dim));
+        let classes = match session.hess.as_ref() {
+            Some(h) => node_colors(h, dim),
+            None => node_colors(&problem.hessian_pattern(), dim),
+        };
+        session.colors = Some(classes);
     }
     let colors = session.colors.take().unwrap_or_default();
     let free = problem.free_nodes().to_vec();

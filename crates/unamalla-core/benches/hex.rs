@@ -1,0 +1,93 @@
+//! Criterion benchmarks of the structured hexahedral pipeline (issue #10, seed 004):
+//!
+//! * `hex/algorithm_a/sphere20`: Algorithm A (`run_hex` with the default options, A only) on
+//!   the perturbed sphere 20³ of the thesis (seed 1; grid construction and perturbation are
+//!   outside the timed part);
+//! * `hex/hessian/{node_block,reference}/{20,50}`: one Hessian refresh of `H_ω`
+//!   (ω = 10⁻³·v̄, parametric scaling) on the perturbed sphere with 20³ / 50³ nodes, with the
+//!   node-block assembly used by the solvers and with the per-tetrahedron reference assembly
+//!   it replaced.
+//!
+//! ```sh
+//! CARGO_TARGET_DIR=... cargo bench -p unamalla-core --bench hex
+//! RAYON_NUM_THREADS=1 cargo bench -p unamalla-core --bench hex -- hessian   # one core
+//! ```
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
+use unamalla_core::functionals::{HexFunctional, HexTopology, Problem, Scaling3};
+use unamalla_core::hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
+use unamalla_core::mesh::StructuredGrid3;
+use unamalla_core::optim::NullObserver;
+
+fn sphere(nodes: usize) -> StructuredGrid3 {
+    let case = HexCase::Sphere;
+    let dims = (nodes, nodes, nodes);
+    let mut g = case.initial_grid(dims).expect("sphere grid");
+    case.default_perturbation(dims)
+        .apply(&mut g, 1)
+        .expect("perturbation");
+    g
+}
+
+fn bench_algorithm_a(c: &mut Criterion) {
+    let mut group = c.benchmark_group("hex/algorithm_a");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(500));
+    group.measurement_time(Duration::from_secs(6));
+    let start = sphere(20);
+    let opts = HexRunOptions {
+        algorithm: HexAlgorithm::A,
+        ..HexRunOptions::default()
+    };
+    group.bench_function("sphere20", |b| {
+        b.iter_batched(
+            || start.clone(),
+            |mut g| {
+                let r = run_hex(&mut g, &opts, &mut NullObserver).expect("run");
+                assert_eq!(r.non_convex_cells, 0);
+                r
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+}
+
+fn bench_hessian(c: &mut Criterion) {
+    let mut group = c.benchmark_group("hex/hessian");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(500));
+    group.measurement_time(Duration::from_secs(4));
+    for nodes in [20usize, 50] {
+        let g = sphere(nodes);
+        let topo = Arc::new(HexTopology::from_mesh(&g).expect("topology"));
+        let x = topo.initial_x();
+        let scaling = Scaling3::Parametric {
+            m: nodes,
+            n: nodes,
+            p: nodes,
+        };
+        // ω relative to the mean Jacobian in the same (parametric) scaling
+        let f1 = HexFunctional::h_omega(topo.clone(), 1.0, scaling).expect("f");
+        let mut v = vec![0.0; f1.num_elements()];
+        f1.element_measures(&x, &mut v);
+        let vbar_p = v.iter().sum::<f64>() / v.len() as f64;
+        let f = HexFunctional::h_omega(topo.clone(), 1e-3 * vbar_p, scaling).expect("f");
+        let mut h = f.hessian_pattern();
+        f.hessian(&x, &mut h); // builds the slot table once
+        group.throughput(Throughput::Elements(10 * topo.num_cells() as u64));
+        group.bench_with_input(BenchmarkId::new("node_block", nodes), &nodes, |b, _| {
+            b.iter(|| f.hessian(&x, &mut h))
+        });
+        group.bench_with_input(BenchmarkId::new("reference", nodes), &nodes, |b, _| {
+            b.iter(|| f.hessian_reference(&x, &mut h))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_algorithm_a, bench_hessian);
+criterion_main!(benches);

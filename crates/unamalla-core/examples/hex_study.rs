@@ -1,0 +1,435 @@
+//! Measurements behind issue #10 (structured hex meshes, seed 004): Algorithm A speed and its
+//! variants, and Algorithm B's μ schedule. Every number in the hex sections of
+//! `docs/benchmarks.md` / `docs/results.md` that is not a plain `unamalla hex` run comes from here.
+//!
+//! ```sh
+//! cargo run --release -p unamalla-core --example hex_study -- a-time [case] [runs]
+//! cargo run --release -p unamalla-core --example hex_study -- a-variants [case]
+//! cargo run --release -p unamalla-core --example hex_study -- hessian [cells] [runs]
+//! cargo run --release -p unamalla-core --example hex_study -- b-study <case> <mu0> <mu_min> <iters> [m,n,p]
+//! ```
+//!
+//! * `a-time`: best-of-`runs` wall time of Algorithm A alone (the `run_hex` driver with the
+//!   default options, perturbation seed 1) and of the Hessian refreshes inside it.
+//! * `a-variants`: the ω loop of Algorithm A re-run with (i) the reference Hessian assembly,
+//!   (ii) the Hessian refreshed only every k-th outer iteration, (iii) other ω₀ and ω factors;
+//!   prints iterations, Hessian refreshes, non-convex cells and seconds per variant.
+//! * `b-study`: Algorithm A then B with the given μ₀, μ_min and iterations per μ step, then an
+//!   analysis of the interior faces still at `|cos| ≥ 10⁻²`: their position in the interior
+//!   block (distance in cells to the block's surface) and the ratio of the reported measure
+//!   (max over the four relabellings) to the penalized cosine (first vertex only).
+//! * `hessian`: one Hessian refresh of `H_ω` on a folded `cells³` grid, node-block against
+//!   the reference assembly (best of `runs`).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+use unamalla_core::functionals::{Csr, HexFunctional, HexTopology, LocalModel, Problem, Scaling3};
+use unamalla_core::hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
+use unamalla_core::optim::monitor::Session;
+use unamalla_core::optim::solver::minimize_with;
+use unamalla_core::optim::{NullObserver, Phase, SolverOptions};
+
+/// User + system CPU seconds of this process (all threads), from `/proc/self/stat`
+/// (clock ticks of 10 ms); NaN where unavailable.
+fn cpu_seconds() -> f64 {
+    let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {
+        return f64::NAN;
+    };
+    // fields after the ")" of the command name: state is field 3, utime 14, stime 15
+    let Some(rest) = s.rsplit(')').next() else {
+        return f64::NAN;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let tick = |i: usize| {
+        f.get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    (tick(11) + tick(12)) / 100.0
+}
+
+/// `H_ω` with a choice of Hessian assembly and refresh interval, counting refreshes.
+struct Variant {
+    f: HexFunctional,
+    reference: bool,
+    every: usize,
+    calls: AtomicUsize,
+    refreshes: Arc<AtomicUsize>,
+    hess_seconds: Arc<std::sync::Mutex<f64>>,
+}
+
+impl Problem for Variant {
+    fn dim(&self) -> usize {
+        3
+    }
+    fn num_vars(&self) -> usize {
+        self.f.num_vars()
+    }
+    fn free_nodes(&self) -> &[usize] {
+        self.f.free_nodes()
+    }
+    fn var_of(&self, node: usize) -> Option<usize> {
+        self.f.var_of(node)
+    }
+    fn value(&self, x: &[f64]) -> f64 {
+        self.f.value(x)
+    }
+    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
+        self.f.value_grad(x, g)
+    }
+    fn hessian_pattern(&self) -> Csr {
+        self.f.hessian_pattern()
+    }
+    fn hessian(&self, x: &[f64], h: &mut Csr) {
+        let n = self.calls.fetch_add(1, Ordering::Relaxed);
+        if n % self.every != 0 {
+            return; // keep the previous values (lagged Hessian)
+        }
+        let t = Instant::now();
+        if self.reference {
+            self.f.hessian_reference(x, h);
+        } else {
+            self.f.hessian(x, h);
+        }
+        if let Ok(mut s) = self.hess_seconds.lock() {
+            *s += t.elapsed().as_secs_f64();
+        }
+        self.refreshes.fetch_add(1, Ordering::Relaxed);
+    }
+    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+        self.f.hess_vec(x, v, out)
+    }
+    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
+        self.f.local(x, node)
+    }
+    fn num_elements(&self) -> usize {
+        self.f.num_elements()
+    }
+    fn element_measures(&self, x: &[f64], out: &mut [f64]) {
+        self.f.element_measures(x, out)
+    }
+}
+
+struct AOutcome {
+    iterations: usize,
+    steps: usize,
+    refreshes: usize,
+    hess_seconds: f64,
+    non_convex: usize,
+    seconds: f64,
+    cpu: f64,
+}
+
+/// Algorithm A's ω loop (the same steps as `omega_continuation_hex`: minimize, stop when
+/// ε-convex, else ω ← factor·ω; then one refinement run with the ε guard).
+fn algorithm_a(
+    case: HexCase,
+    reference: bool,
+    every: usize,
+    omega0_rel: f64,
+    factor: f64,
+) -> AOutcome {
+    let dims = case.default_size();
+    let mut g = case.initial_grid(dims).expect("grid");
+    case.default_perturbation(dims)
+        .apply(&mut g, 1)
+        .expect("perturbation");
+    let defaults = HexRunOptions::default();
+    let opts = &defaults.omega;
+    let scaling = Scaling3::Parametric {
+        m: dims.0,
+        n: dims.1,
+        p: dims.2,
+    };
+    let t0 = Instant::now();
+    let cpu0 = cpu_seconds();
+    let topo = Arc::new(HexTopology::from_mesh(&g).expect("topology"));
+    let mut x = topo.initial_x();
+    let probe = HexFunctional::h_omega(topo.clone(), 1.0, scaling).expect("probe");
+    let mut obs = NullObserver;
+    let mut session = Session::new(&probe, &x, &mut obs);
+    let c0 = session.convexity(&probe, &x);
+    let vbar = c0.mean;
+    let refreshes = Arc::new(AtomicUsize::new(0));
+    let hess_seconds = Arc::new(std::sync::Mutex::new(0.0));
+    let make = |w: f64| Variant {
+        f: HexFunctional::h_omega(topo.clone(), w, scaling).expect("functional"),
+        reference,
+        every,
+        calls: AtomicUsize::new(0),
+        refreshes: refreshes.clone(),
+        hess_seconds: hess_seconds.clone(),
+    };
+    let solver: SolverOptions = opts.solver.clone();
+    let mut omega = omega0_rel * vbar;
+    let floor = opts.omega_floor_rel * vbar;
+    let mut iterations = 0;
+    let mut steps = 0;
+    session.set_phase(Phase::Homotopic);
+    let mut ok = false;
+    loop {
+        let p = make(omega);
+        let r = minimize_with(&p, &mut x, &solver, &mut session, None).expect("minimize");
+        iterations += r.iterations;
+        steps += 1;
+        if session.convexity(&probe, &x).eps_convex(opts.eps) {
+            ok = true;
+            break;
+        }
+        if omega * factor < floor {
+            break;
+        }
+        omega *= factor;
+    }
+    if ok && opts.refinement {
+        session.set_phase(Phase::Classic);
+        session.guard_threshold = opts.eps * vbar;
+        let p = make(omega);
+        let r = minimize_with(&p, &mut x, &solver, &mut session, None).expect("refine");
+        iterations += r.iterations;
+        session.guard_threshold = 0.0;
+    }
+    let seconds = t0.elapsed().as_secs_f64();
+    let c = session.convexity(&probe, &x);
+    let hs = hess_seconds.lock().map(|s| *s).unwrap_or(f64::NAN);
+    AOutcome {
+        iterations,
+        steps,
+        refreshes: refreshes.load(Ordering::Relaxed),
+        hess_seconds: hs,
+        non_convex: c.nonconvex_cells,
+        seconds,
+        cpu: cpu_seconds() - cpu0,
+    }
+}
+
+fn a_time(case: HexCase, runs: usize) {
+    let dims = case.default_size();
+    let mut best = f64::INFINITY;
+    let mut it = 0;
+    for _ in 0..runs {
+        let mut g = case.initial_grid(dims).expect("grid");
+        case.default_perturbation(dims)
+            .apply(&mut g, 1)
+            .expect("perturbation");
+        let opts = HexRunOptions {
+            algorithm: HexAlgorithm::A,
+            ..HexRunOptions::default()
+        };
+        let r = run_hex(&mut g, &opts, &mut NullObserver).expect("run");
+        let st = r.algorithm_a.expect("A ran");
+        best = best.min(st.seconds);
+        it = st.iterations;
+        assert_eq!(r.non_convex_cells, 0, "A must end convex");
+    }
+    println!(
+        "{} {}x{}x{} Algorithm A: {it} iterations, best of {runs}: {best:.3} s wall",
+        case.name(),
+        dims.0,
+        dims.1,
+        dims.2
+    );
+}
+
+fn a_variants(case: HexCase) {
+    println!(
+        "{:<34} {:>5} {:>5} {:>9} {:>9} {:>4} {:>8} {:>8}",
+        "variant", "it", "steps", "H-refresh", "H-seconds", "NC", "wall s", "CPU s"
+    );
+    let d = HexRunOptions::default().omega.omega0_rel;
+    let variants: Vec<(String, bool, usize, f64, f64)> = vec![
+        ("node-block Hessian (default)".into(), false, 1, d, 0.5),
+        ("reference Hessian".into(), true, 1, d, 0.5),
+        ("Hessian every 2nd iteration".into(), false, 2, d, 0.5),
+        ("Hessian every 3rd iteration".into(), false, 3, d, 0.5),
+        ("ω₀ = 1·v̄".into(), false, 1, 1.0, 0.5),
+        ("ω₀ = 0.01·v̄".into(), false, 1, 0.01, 0.5),
+        ("ω₀ = 0.001·v̄".into(), false, 1, 0.001, 0.5),
+        ("ω ← 0.1·ω".into(), false, 1, d, 0.1),
+        ("ω₀ = 0.01·v̄, ω ← 0.1·ω".into(), false, 1, 0.01, 0.1),
+    ];
+    for (name, reference, every, w0, factor) in variants {
+        let o = algorithm_a(case, reference, every, w0, factor);
+        println!(
+            "{:<34} {:>5} {:>5} {:>9} {:>9.3} {:>4} {:>8.3} {:>8.2}",
+            name,
+            o.iterations,
+            o.steps,
+            o.refreshes,
+            o.hess_seconds,
+            o.non_convex,
+            o.seconds,
+            o.cpu
+        );
+    }
+}
+
+fn hessian(cells: usize, runs: usize) {
+    let case = HexCase::Sphere;
+    let dims = (cells + 1, cells + 1, cells + 1);
+    let mut g = case.initial_grid(dims).expect("grid");
+    case.default_perturbation(dims)
+        .apply(&mut g, 1)
+        .expect("perturbation");
+    let topo = Arc::new(HexTopology::from_mesh(&g).expect("topology"));
+    let f = HexFunctional::h_omega(
+        topo.clone(),
+        1e-3,
+        Scaling3::Parametric {
+            m: dims.0,
+            n: dims.1,
+            p: dims.2,
+        },
+    )
+    .expect("functional");
+    let x = topo.initial_x();
+    let mut h = f.hessian_pattern();
+    let t = Instant::now();
+    f.hessian(&x, &mut h);
+    println!(
+        "first refresh (builds the slot table): {:.1} ms",
+        1e3 * t.elapsed().as_secs_f64()
+    );
+    for (name, reference) in [("node-block", false), ("reference", true)] {
+        let mut best = f64::INFINITY;
+        for _ in 0..runs {
+            let t = Instant::now();
+            if reference {
+                f.hessian_reference(&x, &mut h);
+            } else {
+                f.hessian(&x, &mut h);
+            }
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        println!(
+            "sphere {cells}³ cells, Hessian refresh {name}: best of {runs} {:.2} ms",
+            1e3 * best
+        );
+    }
+}
+
+fn b_study(
+    case: HexCase,
+    mu0: f64,
+    mu_min: f64,
+    iters: usize,
+    dims: Option<(usize, usize, usize)>,
+) {
+    use unamalla_core::functionals::{
+        face_coplanarity_cos, face_planarity_max_cos, HEX_QUAD_FACES,
+    };
+    use unamalla_core::mesh::hexgen::{classify_cells, CellClass};
+    use unamalla_core::mesh::HasHexCells;
+    let dims = dims.unwrap_or_else(|| case.default_size());
+    let mut g = case.initial_grid(dims).expect("grid");
+    case.default_perturbation(dims)
+        .apply(&mut g, 1)
+        .expect("perturbation");
+    let mut opts = HexRunOptions::default();
+    opts.coplanarity.mu0 = mu0;
+    opts.coplanarity.mu_min = mu_min;
+    opts.coplanarity.solver.max_iter = iters;
+    let r = run_hex(&mut g, &opts, &mut NullObserver).expect("run");
+    let a = r.after_a.as_ref().expect("A");
+    let (sa, sb) = (r.algorithm_a.as_ref().expect("A"), r.algorithm_b.as_ref());
+    println!(
+        "{} {}x{}x{} μ₀ {mu0:e} μ_min {mu_min:e} iters/step {iters}: A {} it {:.2} s, NH after A {} → after B {} (max|cos| {:.2e}), NC {}, B {} it {} steps {:.2} s",
+        case.name(), dims.0, dims.1, dims.2, sa.iterations, sa.seconds, a.non_hex_interior_cells,
+        r.non_hex_interior_cells, r.max_abs_cos, r.non_convex_cells,
+        sb.map_or(0, |b| b.iterations), sb.map_or(0, |b| b.continuation_steps), sb.map_or(0.0, |b| b.seconds)
+    );
+    // where are the remaining non-planar faces?
+    let cls = classify_cells(&g);
+    let (m, n, p) = dims;
+    let mut by_depth = std::collections::BTreeMap::<usize, usize>::new();
+    let mut by_place = [0usize; 4];
+    let mut ratios = Vec::new();
+    for (c, cl) in cls.iter().enumerate() {
+        if *cl != CellClass::Interior {
+            continue;
+        }
+        let (i, j, k) = (
+            c % (m - 1),
+            (c / (m - 1)) % (n - 1),
+            c / ((m - 1) * (n - 1)),
+        );
+        // interior cells have i in 1..=m-4: depth 0 = on the block surface
+        let depth = [i - 1, m - 4 - i, j - 1, n - 4 - j, k - 1, p - 4 - k]
+            .into_iter()
+            .min()
+            .unwrap_or(0);
+        let h = g.hex_points(c);
+        let mut bad = false;
+        for f in HEX_QUAD_FACES {
+            let q = f.map(|v| h[v]);
+            let mx = face_planarity_max_cos(q);
+            if mx >= 1e-2 {
+                bad = true;
+                let k0 = face_coplanarity_cos(q).abs();
+                ratios.push(mx / k0.max(1e-300));
+            }
+        }
+        if bad {
+            *by_depth.entry(depth).or_default() += 1;
+            // 0 = inside the block, 1 = on a face, 2 = on an edge, 3 = at a corner of it
+            let ext = [(i, m), (j, n), (k, p)]
+                .into_iter()
+                .filter(|&(x, d)| x == 1 || x == d - 4)
+                .count();
+            by_place[ext] += 1;
+        }
+    }
+    println!("  non-hex interior cells by depth in the interior block: {by_depth:?}");
+    println!(
+        "  … by place in the block: inside {}, on a block face {}, on a block edge {}, at a block corner {}",
+        by_place[0], by_place[1], by_place[2], by_place[3]
+    );
+    if !ratios.is_empty() {
+        ratios.sort_by(f64::total_cmp);
+        println!(
+            "  bad faces {}: max|cos| / penalized |k| min {:.2} median {:.2} max {:.2}",
+            ratios.len(),
+            ratios[0],
+            ratios[ratios.len() / 2],
+            ratios[ratios.len() - 1]
+        );
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mode = args.first().map(String::as_str).unwrap_or("a-time");
+    let case = || -> HexCase {
+        args.get(1)
+            .map(|s| s.parse().expect("case"))
+            .unwrap_or(HexCase::Sphere)
+    };
+    match mode {
+        "a-time" => a_time(
+            case(),
+            args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5),
+        ),
+        "a-variants" => a_variants(case()),
+        "hessian" => {
+            let cells = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(19);
+            hessian(cells, args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5));
+        }
+        "b-study" => {
+            let num = |i: usize, d: f64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+            let dims = args.get(5).map(|s| {
+                let v: Vec<usize> = s.split(',').map(|t| t.parse().expect("size")).collect();
+                (v[0], v[1], v[2])
+            });
+            b_study(
+                case(),
+                num(2, 0.1),
+                num(3, 1e-12),
+                num(4, 50.0) as usize,
+                dims,
+            );
+        }
+        other => eprintln!("unknown mode {other}: a-time | a-variants | hessian | b-study"),
+    }
+}
