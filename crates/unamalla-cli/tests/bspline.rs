@@ -2,7 +2,7 @@
 //! fields, output files, and bad input giving one error line without output.
 
 mod common;
-use common::{bin, fixture, report, tmpdir};
+use common::{bin, fixture, report, tmpdir, RunOk};
 
 use std::path::{Path, PathBuf};
 
@@ -48,18 +48,12 @@ fn biquadratic_single_net_report_and_files() {
     let dir = tmpdir("single");
     let region = wavy_region(&dir);
     let out = dir.join("out");
-    let st = bin()
+    bin()
         .arg("bspline")
         .arg(&region)
         .args(["--degree", "2", "--net", "20x12", "--samples", "400", "-o"])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v = report(&out);
     assert_eq!(v["degree"], 2);
     assert_eq!(v["net"], serde_json::json!([20, 12]));
@@ -101,13 +95,7 @@ fn bilinear_single_net_theorem1_holds() {
             "-o",
         ])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
     assert_eq!(v, report(&out));
     assert_eq!(v["theorem1"], true);
@@ -120,7 +108,7 @@ fn bilinear_single_net_theorem1_holds() {
 fn blocks_of_a_region_with_a_hole() {
     let dir = tmpdir("blocks");
     let out = dir.join("out");
-    let st = bin()
+    bin()
         .arg("bspline")
         .arg(fixture("kiwi-bird.geojson"))
         .args([
@@ -133,13 +121,7 @@ fn blocks_of_a_region_with_a_hole() {
             "-o",
         ])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v = report(&out);
     assert_eq!(v["mode"], "blocks");
     let blocks = v["blocks"].as_array().unwrap();

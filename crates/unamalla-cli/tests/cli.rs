@@ -2,7 +2,7 @@
 //! one clear error line, a non-zero exit code and no output file.
 
 mod common;
-use common::{bin, fixture, tmpdir};
+use common::{bin, fixture, tmpdir, RunOk};
 
 use std::path::Path;
 
@@ -15,23 +15,11 @@ fn tfi_on_colorado_then_quality_json() {
         .arg(fixture("colorado.geojson"))
         .args(["--auto-corners", "--size", "60x40", "-o"])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let text = String::from_utf8_lossy(&st.stdout);
     assert!(text.contains("non-convex cells: 0"), "{text}");
 
-    let q = bin()
-        .arg("quality")
-        .arg(&out)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(q.status.success(), "{}", String::from_utf8_lossy(&q.stderr));
+    let q = bin().arg("quality").arg(&out).arg("--json").run_ok();
     let v: serde_json::Value = serde_json::from_slice(&q.stdout).unwrap();
     // 60 × 40 nodes → 59 × 39 cells
     assert_eq!(v["num_cells"], 59 * 39);
@@ -61,18 +49,12 @@ fn explicit_corners_are_file_indices() {
         r#"{"type":"Polygon","coordinates":[[[0,0],[0,2],[1,2],[2,2],[2,0],[0,0]]]}"#,
     )
     .unwrap();
-    let st = bin()
+    bin()
         .arg("tfi")
         .arg(&region)
         .args(["--corners", "0,4,3,1", "--size", "3x3", "-o"])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let q = bin()
         .arg("quality")
         .arg(&out)
@@ -166,13 +148,7 @@ fn mesh_writes_every_output_and_report_fields() {
         .arg(fixture("kiwi-bird.geojson"))
         .args(["--cells", "2000", "--quiet", "--json", "-o"])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
     for key in [
         "region",
@@ -273,13 +249,7 @@ fn eval_raw_length_on_a_hand_written_grid() {
         .arg("eval")
         .arg(&f)
         .args(["--functional", "length", "--raw"])
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
     assert!((v["value"].as_f64().unwrap() - 32.0).abs() < 1e-12, "{v}");
     assert!(v["gradient_norm"].as_f64().unwrap().abs() < 1e-12, "{v}");

@@ -2,21 +2,15 @@
 //! B, a perturbed sphere through Algorithm A, a directory of six face grids, and bad input.
 
 mod common;
-use common::{bin, report, tmpdir};
+use common::{bin, report, tmpdir, RunOk};
 
 #[test]
 fn box_case_with_algorithm_b_has_planar_interior_faces_and_all_outputs() {
     let dir = tmpdir("box");
-    let st = bin()
+    bin()
         .args(["hex", "box", "--algorithm", "b", "--quiet", "-o"])
         .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v = report(&dir);
     // 5³ nodes → 4³ = 64 cells, (5−3)³ = 8 interior cells
     assert_eq!(v["cells"], 64);
@@ -66,13 +60,7 @@ fn perturbed_sphere_becomes_convex_with_algorithm_a() {
             "-o",
         ])
         .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     // --json prints the same report that is written
     let printed: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
     let v = report(&dir);
@@ -112,18 +100,12 @@ fn a_directory_of_face_grids_is_meshed() {
     write("k_min", &|i, j| at(i, j, 0));
     write("k_max", &|i, j| at(i, j, n - 1));
     let out = dir.join("out");
-    let st = bin()
+    bin()
         .args(["hex"])
         .arg(&faces)
         .args(["--quiet", "-o"])
         .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v = report(&out);
     assert_eq!(v["cells"], 27);
     assert_eq!(v["start"]["non_convex_cells"], 0);
@@ -177,7 +159,7 @@ fn bad_arguments_are_one_line_errors() {
 #[test]
 fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
     let dir = tmpdir("box_mu");
-    let st = bin()
+    bin()
         .args([
             "hex",
             "box",
@@ -191,13 +173,7 @@ fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
             "-o",
         ])
         .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+        .run_ok();
     let v = report(&dir);
     let c = &v["options"]["coplanarity"];
     assert_eq!(c["mu0"].as_f64(), Some(500.0));

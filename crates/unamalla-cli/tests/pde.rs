@@ -1,33 +1,22 @@
 //! End-to-end tests of `unamalla pde` and `unamalla refine`.
 
 mod common;
-use common::{bin, fixture, tmpdir};
+use common::{bin, fixture, stdout_ok, tmpdir, RunOk};
 
 use std::path::Path;
 use std::process::Output;
 
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 fn tfi(region: &str, size: &str, out: &Path) {
-    let st = bin()
+    bin()
         .arg("tfi")
         .arg(fixture(region))
         .args(["--size", size, "-o"])
         .arg(out)
-        .output()
-        .unwrap();
-    ok(&st);
+        .run_ok();
 }
 
 fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_str(&ok(out)).unwrap()
+    serde_json::from_str(&stdout_ok(out)).unwrap()
 }
 
 #[test]
@@ -100,9 +89,8 @@ fn manufactured_error_shrinks_under_refinement_and_solvers_agree() {
         .arg(&coarse)
         .args(["--factor", "2", "-o"])
         .arg(&fine)
-        .output()
-        .unwrap();
-    assert!(ok(&r).contains("17 × 13 → 33 × 25 nodes"));
+        .run_ok();
+    assert!(String::from_utf8_lossy(&r.stdout).contains("17 × 13 → 33 × 25 nodes"));
     let run = |mesh: &Path, solver: &str, tag: &str| {
         json(
             &bin()

@@ -30,6 +30,7 @@
 //! reported ([`crate::pipeline::MeshReport::bent_corners`]).
 
 use unamalla_mesh::geometry::segments_intersect;
+use unamalla_mesh::quality::quad_boundary_edges;
 use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells};
 
 /// Default angle deficit (degrees) given to a flat boundary corner: its cell's angle becomes at
@@ -58,7 +59,7 @@ pub fn bend_flat_corners(mesh: &mut BlockMesh2, min_deficit_deg: f64) -> usize {
             owner[v] = c;
         }
     }
-    let boundary = boundary_edges(global);
+    let boundary = quad_boundary_edges(global);
     let nodes = global.nodes().to_vec();
     let mut moves: Vec<(usize, DVec2)> = Vec::new();
     for v in 0..nn {
@@ -119,25 +120,6 @@ pub fn bend_flat_corners(mesh: &mut BlockMesh2, min_deficit_deg: f64) -> usize {
         mesh.sync_blocks();
     }
     count
-}
-
-/// Boundary edges (edges of exactly one cell) as node pairs.
-fn boundary_edges<M: HasQuadCells>(m: &M) -> Vec<[usize; 2]> {
-    let mut count = std::collections::HashMap::<(usize, usize), u32>::new();
-    for c in 0..m.num_quads() {
-        let q = m.quad(c);
-        for k in 0..4 {
-            let (a, b) = (q[k], q[(k + 1) % 4]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    let mut e: Vec<[usize; 2]> = count
-        .into_iter()
-        .filter(|&(_, n)| n == 1)
-        .map(|((a, b), _)| [a, b])
-        .collect();
-    e.sort_unstable();
-    e
 }
 
 /// Whether the segments a→t and t→b cross a boundary edge not incident to a, v or b (exact

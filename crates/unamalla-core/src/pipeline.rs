@@ -402,8 +402,12 @@ impl Mesher {
         let holes_dropped = prepared.holes_dropped;
         // a decomposition file fits either region: ours (saved by a previous run) fits the one
         // without features, one made by hand for the simplified region fits the other
+        // (validated here, once: the error names the simplified region when neither fits)
         let simplified = match &self.decomposition {
-            Some(d) if d.validate(&prepared.mesh_region).is_err() => prepared.simplified,
+            Some(d) if d.validate(&prepared.mesh_region).is_err() => {
+                d.validate(&prepared.simplified)?;
+                prepared.simplified
+            }
             _ => prepared.mesh_region,
         };
         lap(Stage::Simplify, &mut timer);
@@ -448,10 +452,7 @@ impl Mesher {
                 // 2. decompose
                 self.stage(Stage::Decompose, "decomposing into blocks");
                 let decomposition = match self.decomposition.take() {
-                    Some(d) => {
-                        d.validate(&simplified)?;
-                        d
-                    }
+                    Some(d) => d,
                     None => decompose(&simplified, &self.decompose_opts)?,
                 };
                 lap(Stage::Decompose, &mut timer);

@@ -309,29 +309,13 @@ impl<const K: usize> Assembly<K> {
     where
         F: Fn(usize) -> f64 + Sync,
     {
-        let mut guard = match self.scratch.lock() {
-            Ok(g) => g,
-            Err(p) => p.into_inner(),
-        };
-        let ncells = self.cells.len();
-        let sums = SyncPtr::new(&mut guard);
-        for color in &self.colors {
-            color.par_iter().with_max_len(1).for_each(|&ch| {
-                let ch = ch as usize;
-                let start = ch * CHUNK_CELLS;
-                let end = (start + CHUNK_CELLS).min(ncells);
-                let mut s = 0.0;
-                for c in start..end {
-                    s += per_cell(c);
-                }
-                // SAFETY: chunk `ch` is processed exactly once; index < num_chunks.
-                unsafe {
-                    let p = sums;
-                    *p.0.add(ch) = s;
-                }
-            });
-        }
-        guard.iter().sum()
+        self.run_colored_chunks(|start, end| {
+            let mut s = 0.0;
+            for c in start..end {
+                s += per_cell(c);
+            }
+            s
+        })
     }
 
     /// Like [`run_colored`](Self::run_colored) with one call per chunk: `per_chunk(start, end)`

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
 /// The `unamalla` binary under test.
 pub fn bin() -> Command {
@@ -33,4 +33,30 @@ pub fn tmpdir(tag: &str) -> PathBuf {
 /// The `report.json` an output directory holds.
 pub fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()
+}
+
+/// Running a command that must succeed.
+pub trait RunOk {
+    /// Runs the command, asserts it exited successfully (its stderr in the failure message)
+    /// and returns its output.
+    fn run_ok(&mut self) -> Output;
+}
+
+impl RunOk for Command {
+    fn run_ok(&mut self) -> Output {
+        let out = self.output().unwrap();
+        stdout_ok(&out);
+        out
+    }
+}
+
+/// Asserts that a finished command succeeded (its stderr in the failure message) and returns
+/// its stdout.
+pub fn stdout_ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
 }

@@ -261,6 +261,16 @@ pub fn quad_boundary_nodes<M: HasQuadCells + ?Sized>(mesh: &M) -> Vec<bool> {
     b
 }
 
+/// The boundary edges of a quad mesh: `[a, b]` with `a < b` for every edge used by exactly
+/// one cell, sorted (from the same edge census as [`quad_boundary_nodes`]).
+pub fn quad_boundary_edges<M: HasQuadCells + ?Sized>(mesh: &M) -> Vec<[usize; 2]> {
+    quad_edges(mesh)
+        .into_iter()
+        .filter(|&(_, n)| n == 1)
+        .map(|((a, b), _)| [a, b])
+        .collect()
+}
+
 /// Valence of every node: the number of distinct mesh edges incident to it (for an interior
 /// node of a conformal quad mesh, also the number of cells around it). Nodes of no cell: 0.
 pub fn quad_node_valences<M: HasQuadCells + ?Sized>(mesh: &M) -> Vec<usize> {
@@ -476,6 +486,14 @@ mod tests {
             assert_eq!(on_boundary, crate::traits::FreeNodes::is_fixed(&g, v));
         }
         assert_eq!(b.len(), g.num_nodes());
+        // boundary edges: the perimeter of an (m−1) × (n−1)-cell grid has 2(m−1) + 2(n−1)
+        // edges, each joining two boundary nodes that are adjacent in i or j
+        let e = quad_boundary_edges(&g);
+        assert_eq!(e.len(), 2 * (g.m() - 1) + 2 * (g.n() - 1));
+        for [a, c] in &e {
+            assert!(a < c && b[*a] && b[*c]);
+            assert!(c - a == 1 || c - a == g.m());
+        }
         // same through an unstructured copy
         let q = QuadMesh::from_grid(&g);
         assert_eq!(interior_singularities(&q), v);

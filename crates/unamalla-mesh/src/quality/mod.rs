@@ -70,9 +70,9 @@ pub use hex::{
 };
 pub use mesh::{
     alpha_stats, hex_cell_metrics, hex_metrics_per_cell, hex_non_convex_count,
-    interior_singularities, is_eps_convex, is_high_quality, non_convex_cells, quad_boundary_nodes,
-    quad_cell_metrics, quad_metrics_per_cell, quad_node_valences, AlphaStats, InteriorValence,
-    MuBands, MuHistogram, HIGH_QUALITY_FRACTION, MU_FAIR, MU_GOOD,
+    interior_singularities, is_eps_convex, is_high_quality, non_convex_cells, quad_boundary_edges,
+    quad_boundary_nodes, quad_cell_metrics, quad_metrics_per_cell, quad_node_valences, AlphaStats,
+    InteriorValence, MuBands, MuHistogram, HIGH_QUALITY_FRACTION, MU_FAIR, MU_GOOD,
 };
 pub use quad::{corner_alphas, is_convex, mu, QuadMetrics};
 pub use report::{CellKind, HexSummary, MetricSummary, QuadSummary, QualityReport, ReportOptions};
