@@ -73,21 +73,33 @@ pub fn check_problem<P: Problem>(name: &str, p: &P, x: &[f64], tol: f64) -> Resu
     p.hessian(x, &mut h);
     let dense = h.to_dense();
     let hscale = dense.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    let mut gp = vec![0.0; n];
-    let mut gm = vec![0.0; n];
-    for i in 0..n {
-        let hh = 1e-6 * (1.0 + x[i].abs());
+    // column i of the Hessian by central differences of the gradient with step `rel`
+    let mut fd_column = |i: usize, rel: f64| -> Vec<f64> {
+        let (mut gp, mut gm) = (vec![0.0; n], vec![0.0; n]);
+        let hh = rel * (1.0 + x[i].abs());
         xp[i] = x[i] + hh;
         p.value_grad(&xp, &mut gp);
         xp[i] = x[i] - hh;
         p.value_grad(&xp, &mut gm);
         xp[i] = x[i];
+        (0..n).map(|r| (gp[r] - gm[r]) / (2.0 * hh)).collect()
+    };
+    for i in 0..n {
+        let fd = fd_column(i, 1e-6);
         for r in 0..n {
-            let fd = (gp[r] - gm[r]) / (2.0 * hh);
-            if !close(fd, dense[r][i], tol, hscale) {
+            if close(fd[r], dense[r][i], tol, hscale) {
+                continue;
+            }
+            // φ_ω (H_ω, seed 000 digest §5.5) is only C¹: where an element sits within the
+            // step of its switch point α = ω the central difference straddles the jump of the
+            // second derivative and is wrong; a smaller step on the same side must agree
+            let retry = [1e-7, 1e-8]
+                .iter()
+                .any(|&rel| close(fd_column(i, rel)[r], dense[r][i], tol, hscale));
+            if !retry {
                 return Err(format!(
-                    "{name}: hessian[{r}][{i}] = {} but FD = {fd}",
-                    dense[r][i]
+                    "{name}: hessian[{r}][{i}] = {} but FD = {}",
+                    dense[r][i], fd[r]
                 ));
             }
         }
