@@ -11,6 +11,7 @@ use unamalla_core::hex::{
     read_face_dir, run_hex, write_outputs, HexAlgorithm, HexCase, HexRunOptions, HexScaling,
     Perturbation,
 };
+use unamalla_core::optim::drivers::CoplanarityOptions;
 use unamalla_core::optim::{NullObserver, Observer, ProgressObserver};
 
 /// Arguments of `unamalla hex`.
@@ -40,10 +41,14 @@ pub struct HexArgs {
     /// Tetrahedron Jacobian scaling: parametric (default) or index.
     #[arg(long, default_value = "parametric")]
     pub scaling: String,
-    /// Algorithm B: first penalty parameter μ₀ (weight `C = 1/(2μ)`; thesis default 0.1,
-    /// its Table 4.5 also uses 176–800).
-    #[arg(long, default_value_t = 0.1)]
-    pub mu0: f64,
+    /// Algorithm B schedule: `default` (μ₀ = 500, stop as soon as every interior face has
+    /// |cos| ≤ 10⁻³) or `thesis` (μ₀ = 0.1, μ ← 0.1μ down to 10⁻¹², no planarity stop).
+    #[arg(long, default_value = "default")]
+    pub b_schedule: String,
+    /// Algorithm B: first penalty parameter μ₀ (weight `C = 1/(2μ)`; default: the schedule's,
+    /// 500 or 0.1; the thesis's Table 4.5 also uses 176–800).
+    #[arg(long)]
+    pub mu0: Option<f64>,
     /// Algorithm B: stop the μ continuation (`μ ← 0.1μ`) once `μ ≤ mu-min` (thesis 10⁻¹²).
     #[arg(long, default_value_t = 1e-12)]
     pub mu_min: f64,
@@ -95,8 +100,17 @@ pub fn run(a: HexArgs) -> Result<()> {
         "index" => HexScaling::Index,
         other => bail!("--scaling must be 'parametric' or 'index', got '{other}'"),
     };
+    let mut coplanarity = match a.b_schedule.to_ascii_lowercase().as_str() {
+        "default" => HexRunOptions::default().coplanarity,
+        "thesis" => CoplanarityOptions {
+            solver: HexRunOptions::default().coplanarity.solver,
+            ..CoplanarityOptions::thesis()
+        },
+        other => bail!("--b-schedule must be 'default' or 'thesis', got '{other}'"),
+    };
+    let mu0 = a.mu0.unwrap_or(coplanarity.mu0);
     for (name, v, lo) in [
-        ("--mu0", a.mu0, false),
+        ("--mu0", mu0, false),
         ("--mu-min", a.mu_min, true),
         ("--omega0", a.omega0, false),
     ] {
@@ -107,8 +121,8 @@ pub fn run(a: HexArgs) -> Result<()> {
             );
         }
     }
-    if a.mu_min >= a.mu0 {
-        bail!("--mu-min ({}) must be below --mu0 ({})", a.mu_min, a.mu0);
+    if a.mu_min >= mu0 {
+        bail!("--mu-min ({}) must be below --mu0 ({mu0})", a.mu_min);
     }
     if a.b_iters == 0 || a.a_iters == 0 {
         bail!("--a-iters and --b-iters must be at least 1");
@@ -155,8 +169,9 @@ pub fn run(a: HexArgs) -> Result<()> {
         scaling,
         ..HexRunOptions::default()
     };
-    opts.coplanarity.mu0 = a.mu0;
-    opts.coplanarity.mu_min = a.mu_min;
+    coplanarity.mu0 = mu0;
+    coplanarity.mu_min = a.mu_min;
+    opts.coplanarity = coplanarity;
     opts.coplanarity.solver.max_iter = a.b_iters;
     opts.omega.solver.max_iter = a.a_iters;
     opts.omega.omega0_rel = a.omega0;
@@ -195,11 +210,12 @@ pub fn run(a: HexArgs) -> Result<()> {
                 r.non_convex_cells, r.non_hex_interior_cells, r.max_abs_cos, st.iterations, st.seconds, st.status
             );
             println!(
-                "         μ schedule: {} steps, μ₀ {:e} → {:e} (×0.1, ≤ {} iterations each)",
+                "         μ schedule: {} steps, μ₀ {:e} → {:e} (×0.1, ≤ {} iterations each; planarity stop {:?})",
                 st.continuation_steps,
                 report.options.coplanarity.mu0,
                 st.mu.unwrap_or(f64::NAN),
-                report.options.coplanarity.solver.max_iter
+                report.options.coplanarity.solver.max_iter,
+                report.options.coplanarity.stop_cos
             );
         }
         println!(

@@ -163,6 +163,8 @@ fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
         .args([
             "hex",
             "box",
+            "--b-schedule",
+            "thesis",
             "--mu0",
             "500",
             "--mu-min",
@@ -179,6 +181,8 @@ fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
     assert_eq!(c["mu0"].as_f64(), Some(500.0));
     assert_eq!(c["mu_min"].as_f64(), Some(1e-6));
     assert_eq!(c["solver"]["max_iter"], 20);
+    // the thesis schedule has no planarity stop
+    assert!(c["stop_cos"].is_null());
     // μ = 500, 50, …, 5e-6 > 1e-6: 9 steps (the last μ is 5·10⁻⁶ up to rounding)
     assert_eq!(v["algorithm_b"]["continuation_steps"], 9);
     assert_eq!(v["non_hex_interior_cells"], 0);
@@ -188,6 +192,7 @@ fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
         vec!["--mu0", "nan"],
         vec!["--mu0", "1e-3", "--mu-min", "1e-2"],
         vec!["--b-iters", "0"],
+        vec!["--b-schedule", "fast"],
     ] {
         let dir = tmpdir("box_mu_bad");
         let out = bin()
@@ -199,7 +204,7 @@ fn mu_schedule_options_reach_the_report_and_bad_values_are_rejected() {
         assert!(!out.status.success(), "{bad:?} was accepted");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(
-            err.contains("--mu") || err.contains("iters"),
+            err.contains("--mu") || err.contains("iters") || err.contains("--b-schedule"),
             "{bad:?}: {err}"
         );
         std::fs::remove_dir_all(&dir).ok();

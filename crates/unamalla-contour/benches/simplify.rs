@@ -1,8 +1,8 @@
 //! Modified-area simplification of a 100,000-vertex ring (criterion; issue #5, < 100 ms).
 //!
 //! Timed: one whole `simplify_region` call on an already validated `Region` (removal with the
-//! topology check, validation of the output with `Region::new`, Hausdorff distance and area
-//! change). Not timed: building and validating the input `Region`. Single-threaded.
+//! topology check, building the output region with `Region::from_simple_rings`, Hausdorff
+//! distance and area change). Not timed: building and validating the input `Region`. Single-threaded.
 //!
 //! ```text
 //! RAYON_NUM_THREADS=1 cargo bench -p unamalla-contour --bench simplify
@@ -33,7 +33,7 @@ fn bench(c: &mut Criterion) {
     let opts = SimplifyOptions::new(Method::ModifiedAreas, Preset::Clean);
     let res = simplify_region(&region, &opts).expect("simplifies");
     eprintln!(
-        "modified-areas eps={}: {} -> {} vertices; elapsed (removal + validation) {:?}",
+        "modified-areas eps={}: {} -> {} vertices; elapsed (removal + output region) {:?}",
         res.epsilon, res.vertices_before, res.vertices_after, res.elapsed
     );
     let mut g = c.benchmark_group("contour");

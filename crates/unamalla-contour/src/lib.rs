@@ -62,9 +62,12 @@
 //! guarantees that the new edge `ac` crosses nothing and that no ring or vertex changes side
 //! (argument in the `removal` module). After the
 //! MPP step, vertices of edges that came to intersect are restored to their input positions
-//! until the rings are valid again. The result is always rebuilt with
-//! [`unamalla_mesh::Region::new`], which validates it with exact predicates; an invalid
-//! region is never returned.
+//! until the rings are valid again (checked with [`unamalla_mesh::Region::new`]). The output
+//! rings are therefore valid by construction, and the result region is built with
+//! [`unamalla_mesh::Region::from_simple_rings`], which runs only the O(n) checks (finite, no
+//! repeated points, non-zero area) and skips the O(n log n) re-validation (issue #5); debug
+//! builds — every test — also validate it with [`unamalla_mesh::Region::new`] and assert that
+//! both agree.
 //!
 //! Every result reports per-ring vertex counts, the relative area change and the Hausdorff
 //! distance to the input, see [`SimplifyResult`]: for the vertex-removal methods the per-edge

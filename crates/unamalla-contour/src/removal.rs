@@ -31,18 +31,47 @@
 //! occupied cells with a locality-preserving slot layout, vertices stored cell by cell). All
 //! of them reproduce the previous decisions exactly (same order of removals, same topology
 //! answers), which `tests/baseline.rs` checks against the outputs stored before the change.
+//!
+//! Second round (issue #5, measured with `perf record`: the loop's time was mostly cache
+//! misses, one per separate per-vertex array): everything the loop reads about a vertex —
+//! point, links, grid slot, liveness and a *stamp* counting its neighbour changes — is one
+//! 32-byte `Node`; the stamp also replaces the queue's "updated" flags and the retry
+//! bookkeeping (an initial key is current iff the stamp is unchanged), so the staleness check
+//! reads the node the topology check needs next anyway; the grid stores only points and
+//! removes by searching the (just scanned) cell, so no per-vertex position array is kept up
+//! to date; and the data of the next queue candidates and of the neighbours whose keys a
+//! removal updates are prefetched an iteration ahead (`touch`). Tried and not kept (no
+//! measurable gain): grid cells of vertex ids instead of points, cache-line-aligned sibling
+//! groups in the heap, a branch-free child selection, recomputing lazily increased keys from
+//! the triangle instead of storing them.
 
 use glam::DVec2;
 use unamalla_mesh::geometry::{orient2d, point_on_segment};
 
+/// Marks a removed vertex in [`Node::slot`].
+const DEAD: u32 = u32::MAX;
+
+/// Everything the removal loop reads about one vertex, in one 32-byte record (two per cache
+/// line): the loop visits vertices in key order, i.e. at random places of the ring, so one
+/// record per vertex costs one cache miss where separate arrays (points, links, liveness, ring,
+/// grid cell) cost one each (issue #5: these misses were most of the topology check's time).
+#[derive(Debug, Clone, Copy)]
+#[repr(C)]
+struct Node {
+    p: DVec2,
+    prev: u32,
+    next: u32,
+    /// The grid table slot of the vertex's cell; [`DEAD`] once removed.
+    slot: u32,
+    /// How many times a neighbour of the vertex was removed (its triangle changed): a key
+    /// computed when the stamp was `s` is current iff the stamp is still `s`.
+    stamp: u32,
+}
+
 /// Linked rings plus a dynamic spatial index of their live vertices.
 #[derive(Debug, Clone)]
 pub(crate) struct Workspace {
-    pts: Vec<DVec2>,
-    ring_of: Vec<u32>,
-    prev: Vec<u32>,
-    next: Vec<u32>,
-    alive: Vec<bool>,
+    nodes: Vec<Node>,
     /// First global id of each ring (ring `r` owns ids `start[r]..start[r + 1]`).
     start: Vec<usize>,
     /// Live vertex count of each ring.
@@ -56,41 +85,34 @@ impl Workspace {
     /// Builds the workspace; rings must form a valid region (simple, disjoint).
     pub(crate) fn new(rings: &[Vec<DVec2>]) -> Self {
         let total: usize = rings.iter().map(Vec::len).sum();
-        let mut pts = Vec::with_capacity(total);
-        let mut ring_of = Vec::with_capacity(total);
-        let mut prev = Vec::with_capacity(total);
-        let mut next = Vec::with_capacity(total);
+        let mut nodes = Vec::with_capacity(total);
         let mut start = Vec::with_capacity(rings.len() + 1);
-        for (r, ring) in rings.iter().enumerate() {
-            let s = pts.len();
+        let mut perimeter = 0.0;
+        for ring in rings {
+            let s = nodes.len();
             start.push(s);
             let n = ring.len();
             for (k, &p) in ring.iter().enumerate() {
-                pts.push(p);
-                ring_of.push(r as u32);
-                prev.push((s + (k + n - 1) % n) as u32);
-                next.push((s + (k + 1) % n) as u32);
+                nodes.push(Node {
+                    p,
+                    prev: (s + (k + n - 1) % n) as u32,
+                    next: (s + (k + 1) % n) as u32,
+                    slot: 0,
+                    stamp: 0,
+                });
             }
+            perimeter += (0..n)
+                .map(|k| ring[k].distance(ring[(k + 1) % n]))
+                .sum::<f64>();
         }
-        start.push(pts.len());
-        let edges: usize = rings.iter().map(Vec::len).sum::<usize>().max(1);
-        let mean_edge = rings
-            .iter()
-            .map(|r| {
-                let n = r.len();
-                (0..n).map(|k| r[k].distance(r[(k + 1) % n])).sum::<f64>()
-            })
-            .sum::<f64>()
-            / edges as f64;
+        start.push(nodes.len());
+        let mean_edge = perimeter / total.max(1) as f64;
+        let grid = Grid::new(&mut nodes, mean_edge);
         Self {
-            alive: vec![true; pts.len()],
             len: rings.iter().map(Vec::len).collect(),
             head: start[..rings.len()].iter().map(|&s| s as u32).collect(),
-            grid: Grid::new(&pts, mean_edge),
-            pts,
-            ring_of,
-            prev,
-            next,
+            grid,
+            nodes,
             start,
         }
     }
@@ -98,31 +120,59 @@ impl Workspace {
     pub(crate) fn num_rings(&self) -> usize {
         self.len.len()
     }
+    /// Total number of vertices (live or removed) over all rings.
+    pub(crate) fn num_vertices(&self) -> usize {
+        self.nodes.len()
+    }
+    /// Live vertex count of ring `r`.
+    pub(crate) fn ring_len(&self, r: usize) -> usize {
+        self.len[r]
+    }
+    #[inline]
+    pub(crate) fn alive(&self, v: usize) -> bool {
+        self.nodes[v].slot != DEAD
+    }
+    #[cfg(test)]
+    pub(crate) fn point(&self, v: usize) -> DVec2 {
+        self.nodes[v].p
+    }
+    /// The ring of vertex `v`.
+    #[inline]
     pub(crate) fn ring(&self, v: usize) -> usize {
-        self.ring_of[v] as usize
+        // `start` is increasing with start[0] = 0 ≤ v, so the index is ≥ 1
+        self.start.partition_point(|&s| s <= v) - 1
+    }
+    /// The stamp of vertex `v` (see [`Node::stamp`]).
+    #[inline]
+    pub(crate) fn stamp(&self, v: usize) -> u32 {
+        self.nodes[v].stamp
     }
     /// The triangle `(prev, v, next)` of a live vertex.
+    #[inline]
     pub(crate) fn triangle(&self, v: usize) -> (DVec2, DVec2, DVec2) {
+        let n = &self.nodes[v];
         (
-            self.pts[self.prev[v] as usize],
-            self.pts[v],
-            self.pts[self.next[v] as usize],
+            self.nodes[n.prev as usize].p,
+            n.p,
+            self.nodes[n.next as usize].p,
         )
     }
+    #[inline]
     pub(crate) fn neighbours(&self, v: usize) -> (usize, usize) {
-        (self.prev[v] as usize, self.next[v] as usize)
+        let n = &self.nodes[v];
+        (n.prev as usize, n.next as usize)
     }
 
     /// Live global ids of ring `r` in ring order, starting at the lowest live id.
     pub(crate) fn ring_ids(&self, r: usize) -> Vec<usize> {
         let first = (self.start[r]..self.start[r + 1])
-            .find(|&v| self.alive[v])
+            .find(|&v| self.alive(v))
             .unwrap_or(self.head[r] as usize);
         let mut out = Vec::with_capacity(self.len[r]);
         let mut v = first;
         loop {
             out.push(v);
-            v = self.next[v] as usize;
+            v = self.nodes[v].next as usize;
             if v == first || out.len() > self.len[r] {
                 break;
             }
@@ -137,36 +187,53 @@ impl Workspace {
     }
     /// Live points of ring `r` in order.
     pub(crate) fn ring_points(&self, r: usize) -> Vec<DVec2> {
-        self.ring_ids(r).into_iter().map(|v| self.pts[v]).collect()
+        self.ring_ids(r)
+            .into_iter()
+            .map(|v| self.nodes[v].p)
+            .collect()
     }
 
     /// `true` if removing live vertex `b` keeps every ring simple and all rings disjoint
-    /// (see the module documentation).
+    /// (see the module documentation): the ring keeps more than 3 vertices (and not 3
+    /// collinear ones), and no other live vertex lies in the closed triangle `abc`.
+    ///
+    /// The grid stores only points, so "other" is decided by coordinates: the scanned
+    /// entries equal to `a`, `b` or `c` are `a`, `b` and `c` themselves — exactly 3, as the
+    /// box holds them — unless another vertex coincides with one of them (impossible in a
+    /// valid region, but e.g. a ring given with a closing duplicate), and then that vertex
+    /// lies in the closed triangle and blocks, as with a test by id.
     pub(crate) fn can_remove(&self, b: usize) -> bool {
-        self.blocker(b).is_ok()
-    }
-
-    /// `Ok(())` if live vertex `b` can be removed; otherwise `Err(Some(v))` naming a live
-    /// vertex `v` in its closed triangle, or `Err(None)` if the ring is too small.
-    pub(crate) fn blocker(&self, b: usize) -> Result<(), Option<usize>> {
-        let r = self.ring(b);
-        if !self.alive[b] || self.len[r] <= 3 {
-            return Err(None);
+        let nb = self.nodes[b];
+        if nb.slot == DEAD {
+            return false;
         }
-        let (ia, ic) = self.neighbours(b);
-        let (a, pb, c) = (self.pts[ia], self.pts[b], self.pts[ic]);
-        if self.len[r] == 4 {
-            let d = self.pts[self.next[ic] as usize];
+        let len = self.len[self.ring(b)];
+        if len <= 3 {
+            return false;
+        }
+        let (na, nc) = (self.nodes[nb.prev as usize], self.nodes[nb.next as usize]);
+        let (a, pb, c) = (na.p, nb.p, nc.p);
+        // prefetch the outer neighbours, whose points the new keys of `a` and `c` need if
+        // the removal goes ahead (see `touch`)
+        touch(&self.nodes[na.prev as usize].slot);
+        touch(&self.nodes[nc.next as usize].slot);
+        if len == 4 {
+            let d = self.nodes[nc.next as usize].p;
             if orient2d(a, c, d) == 0.0 {
-                return Err(None);
+                return false;
             }
         }
         let o = orient_sign(a, pb, c);
         let lo = a.min(pb).min(c);
         let hi = a.max(pb).max(c);
+        let corners = std::cell::Cell::new(0u32);
         let contains = |p: DVec2| -> bool {
             if p.cmplt(lo).any() || p.cmpgt(hi).any() {
                 return false;
+            }
+            if p == a || p == pb || p == c {
+                corners.set(corners.get() + 1);
+                return corners.get() > 3;
             }
             if o > 0.0 {
                 orient_sign(a, pb, p) >= 0.0
@@ -182,28 +249,78 @@ impl Workspace {
                     || point_on_segment(pb, c, p)
             }
         };
-        match self.grid.find_in_box(lo, hi, [ia, b, ic], |v, p| {
-            (v != ia && v != b && v != ic && contains(p)).then_some(v)
-        }) {
-            Some(v) => Err(Some(v)),
-            None => Ok(()),
+        !self
+            .grid
+            .any_in_box(lo, hi, [na.slot, nb.slot, nc.slot], contains)
+    }
+
+    /// Starts loading vertex `v`'s node into the cache (see [`touch`]).
+    #[inline(always)]
+    fn warm(&self, v: usize) {
+        if let Some(n) = self.nodes.get(v) {
+            touch(&n.slot);
+        }
+    }
+    /// Starts loading what [`Workspace::can_remove`] reads after `v`'s node: the nodes of its
+    /// neighbours and its grid cell (its table slot and the cell's first points). Call it once
+    /// `v`'s node is in cache ([`Workspace::warm`] an iteration earlier), or it waits for it.
+    #[inline(always)]
+    fn warm_around(&self, v: usize) {
+        if let Some(n) = self.nodes.get(v) {
+            if n.slot != DEAD {
+                touch(&self.nodes[n.prev as usize].slot);
+                touch(&self.nodes[n.next as usize].slot);
+                if let Some(s) = self.grid.table.get(n.slot as usize) {
+                    if let Some(p) = self.grid.pts.get(s.start as usize) {
+                        touch(&p.x);
+                    }
+                }
+            }
         }
     }
 
-    /// Removes live vertex `b` (callers check [`Workspace::can_remove`] first).
+    /// Removes live vertex `b` (callers check [`Workspace::can_remove`] first) and bumps the
+    /// stamps of its neighbours.
     pub(crate) fn remove(&mut self, b: usize) {
-        debug_assert!(self.alive[b]);
-        let (ia, ic) = self.neighbours(b);
-        self.next[ia] = ic as u32;
-        self.prev[ic] = ia as u32;
-        self.alive[b] = false;
+        let nb = self.nodes[b];
+        debug_assert!(nb.slot != DEAD);
+        let (ia, ic) = (nb.prev as usize, nb.next as usize);
+        let na = &mut self.nodes[ia];
+        na.next = ic as u32;
+        na.stamp = na.stamp.wrapping_add(1);
+        let nc = &mut self.nodes[ic];
+        nc.prev = ia as u32;
+        nc.stamp = nc.stamp.wrapping_add(1);
+        self.nodes[b].slot = DEAD;
         let r = self.ring(b);
         self.len[r] -= 1;
         if self.head[r] as usize == b {
             self.head[r] = ia as u32;
         }
-        self.grid.remove(b as u32);
+        self.grid.remove(nb.slot, nb.p);
     }
+}
+
+/// Software prefetch of the cache line holding `x` (a hint: no effect on any result). The
+/// removal loop is bound by cache misses on data whose address is known an iteration ahead
+/// (the next queue candidates, the neighbours whose keys a removal will update); starting the
+/// load early lets the miss overlap with the current iteration's work instead of stalling the
+/// next one. On x86-64 this is `prefetcht0` (`_mm_prefetch`); a plain read kept alive with
+/// `black_box` was measured too, but it stalls at retirement and gained about half as much.
+/// Elsewhere it does nothing.
+#[inline(always)]
+fn touch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `_mm_prefetch` is `unsafe` only because it is a `target_feature(enable = "sse")`
+    // function, and SSE is part of the x86-64 baseline, so it is available on every x86-64
+    // CPU. The pointer comes from a valid reference, and a prefetch never faults nor changes
+    // memory.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 /// Sign-exact orientation for the topology check: [`crate::criteria::orient2d_fast`], the
@@ -222,15 +339,17 @@ fn orient_sign(a: DVec2, b: DVec2, c: DVec2) -> f64 {
 ///
 /// Flat layout, built once: an open-addressing hash table (linear probing, ≈ 1/4 load) of the
 /// occupied cells, each slot holding the cell's packed coordinates and its range
-/// `start..start + live` of live vertices in one array (`ids` and their points `pts`, stored
-/// cell by cell, CSR-style) — so one probe gives the cell's contents. The home slot keeps the
-/// 4 × 4 blocks of cells together (hash of the block, cell position in the low bits), so the
-/// cells under one triangle's bounding box share one or two cache lines of the table.
-/// Removal swaps the vertex with the last live one of its cell (O(1) via `slot_of[v]` and
-/// `pos[v]`, no hashing); a query probes each cell under the triangle's bounding box (the
-/// cells of the triangle's own vertices are known without hashing) or, for a huge box, scans
-/// the table. Replaces a `HashMap<(i64, i64), Vec<u32>>` (one allocation per cell, SipHash-free
-/// but a hash on every removal) and, before it, a dynamic R*-tree (`docs/benchmarks.md`).
+/// `start..start + live` of live points in one array `pts`, stored cell by cell (CSR-style) —
+/// so one probe gives the cell's contents. The home slot keeps the 4 × 4 blocks of cells
+/// together (hash of the block, cell position in the low bits), so the cells under one
+/// triangle's bounding box share one or two cache lines of the table. Each vertex's
+/// [`Node`] records its cell's slot, so the cells of a triangle's own vertices need no
+/// hashing and a removal none either: it finds the point in its cell's range (a few entries,
+/// just scanned by the topology check, so in cache) and swaps it with the cell's last live one.
+/// Only points are stored (16 bytes an entry; no ids and no per-vertex position, which cost a
+/// cache miss per removal to keep up to date): the topology check identifies `a`, `b`, `c` by
+/// coordinates. Replaces a `HashMap<(i64, i64), Vec<u32>>` and, before it, a dynamic R*-tree
+/// (`docs/benchmarks.md`).
 #[derive(Debug, Clone)]
 struct Grid {
     lo: DVec2,
@@ -239,11 +358,7 @@ struct Grid {
     mask: usize,
     /// Number of occupied cells.
     cells: usize,
-    ids: Vec<u32>,
     pts: Vec<DVec2>,
-    /// Per vertex: the table slot of its cell and its position in `ids`.
-    slot_of: Vec<u32>,
-    pos: Vec<u32>,
 }
 
 /// One slot of the grid's hash table.
@@ -258,13 +373,12 @@ struct Slot {
 impl Grid {
     const EMPTY: u64 = u64::MAX;
 
-    fn new(pts: &[DVec2], mean_edge: f64) -> Self {
-        let lo = pts
-            .iter()
-            .fold(DVec2::splat(f64::INFINITY), |lo, &p| lo.min(p));
-        let hi = pts
-            .iter()
-            .fold(DVec2::splat(f64::NEG_INFINITY), |hi, &p| hi.max(p));
+    /// Builds the grid of the nodes' points and stores each node's slot in [`Node::slot`].
+    fn new(nodes: &mut [Node], mean_edge: f64) -> Self {
+        let (lo, hi) = nodes.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), n| (lo.min(n.p), hi.max(n.p)),
+        );
         let ext = (hi - lo).max_element();
         // ≈ 8 mean edges per cell (on the 100k ring: fewer cells under a triangle's box than
         // with 4, more points per cell, but a cell's points are contiguous; 8 measured ≈ 15 %
@@ -279,18 +393,21 @@ impl Grid {
             table: Vec::new(),
             mask: 0,
             cells: 0,
-            ids: vec![0; pts.len()],
-            pts: vec![DVec2::ZERO; pts.len()],
-            slot_of: vec![0; pts.len()],
-            pos: vec![0; pts.len()],
+            pts: vec![DVec2::ZERO; nodes.len()],
         };
-        // insert the occupied cells, growing the table to keep its load ≤ 1/4 (slots move
-        // when it grows, so they are read afterwards), then count each cell's vertices
-        g.resize((pts.len() / 4).next_power_of_two().max(16));
-        for &p in pts {
-            let (x, y) = g.coord(p);
-            g.insert(Self::pack(x, y));
+        // insert the occupied cells, record each vertex's slot and count each cell's vertices,
+        // growing the table to keep its load ≤ 1/4; slots move when it grows, so then the
+        // slots and counts are redone once the table is final (sized for ≈ 2 vertices per
+        // cell, the table rarely grows: the 100k ring has ≈ 8 per cell)
+        g.resize((nodes.len() / 2).next_power_of_two().max(16));
+        let mut grown = false;
+        for n in nodes.iter_mut() {
+            let (x, y) = g.coord(n.p);
+            let h = g.insert(Self::pack(x, y));
+            n.slot = h as u32;
+            g.table[h].live += 1;
             if 4 * g.cells > g.table.len() {
+                grown = true;
                 let old = std::mem::take(&mut g.table);
                 g.resize(2 * old.len());
                 for s in old.iter().filter(|s| s.key != Self::EMPTY) {
@@ -298,26 +415,29 @@ impl Grid {
                 }
             }
         }
-        for (i, &p) in pts.iter().enumerate() {
-            let (x, y) = g.coord(p);
-            let h = g.insert(Self::pack(x, y));
-            g.slot_of[i] = h as u32;
-            g.table[h].live += 1;
+        if grown {
+            for s in g.table.iter_mut() {
+                s.live = 0;
+            }
+            for n in nodes.iter_mut() {
+                let (x, y) = g.coord(n.p);
+                let h = g.insert(Self::pack(x, y));
+                n.slot = h as u32;
+                g.table[h].live += 1;
+            }
         }
-        // ranges (prefix sums in table order), then place the vertices
+        // ranges (prefix sums in table order), then place the points
         let mut acc = 0u32;
         for s in g.table.iter_mut().filter(|s| s.key != Self::EMPTY) {
             s.start = acc;
             acc += s.live;
             s.live = 0;
         }
-        for (i, &p) in pts.iter().enumerate() {
-            let s = &mut g.table[g.slot_of[i] as usize];
+        for n in nodes.iter() {
+            let s = &mut g.table[n.slot as usize];
             let k = (s.start + s.live) as usize;
             s.live += 1;
-            g.ids[k] = i as u32;
-            g.pts[k] = p;
-            g.pos[i] = k as u32;
+            g.pts[k] = n.p;
         }
         g
     }
@@ -334,10 +454,17 @@ impl Grid {
         self.mask = cap - 1;
         self.cells = 0;
     }
+    /// The cell `(⌊(x − lo.x)/cell⌋, ⌊(y − lo.y)/cell⌋)` of a point. The floor is a truncating
+    /// cast corrected by one below zero (equal to `floor` for every value in range, without
+    /// the libm call that `f64::floor` is on baseline x86-64).
     #[inline]
     fn coord(&self, p: DVec2) -> (i64, i64) {
-        let q = ((p - self.lo) * self.inv_cell).floor();
-        (q.x as i64, q.y as i64)
+        let q = (p - self.lo) * self.inv_cell;
+        let floor = |t: f64| {
+            let i = t as i64;
+            i - ((i as f64) > t) as i64
+        };
+        (floor(q.x), floor(q.y))
     }
     #[inline]
     fn pack(x: i64, y: i64) -> u64 {
@@ -389,54 +516,41 @@ impl Grid {
             h = (h + 1) & self.mask;
         }
     }
-    /// Removes vertex `id` (must be live).
+    /// Removes the live point `p` of the cell in `slot`.
     #[inline]
-    fn remove(&mut self, id: u32) {
-        let s = &mut self.table[self.slot_of[id as usize] as usize];
-        let k = self.pos[id as usize] as usize;
-        s.live -= 1;
-        let last = (s.start + s.live) as usize;
-        if k != last {
-            let moved = self.ids[last];
-            self.ids[k] = moved;
-            self.pts[k] = self.pts[last];
-            self.pos[moved as usize] = k as u32;
+    fn remove(&mut self, slot: u32, p: DVec2) {
+        let s = &mut self.table[slot as usize];
+        let a = s.start as usize;
+        let last = a + s.live as usize - 1;
+        let cell = &mut self.pts[a..=last];
+        let k = cell.iter().position(|&q| q == p);
+        debug_assert!(k.is_some(), "point {p} not in its cell");
+        if let Some(k) = k {
+            cell[k] = cell[cell.len() - 1];
+            s.live -= 1;
         }
     }
-    /// Calls `f(id, point)` on every live vertex in the cells meeting the box `[lo, hi]`
-    /// until it returns `Some`. `near` are live vertices whose cells need no hashing.
+    /// `true` if `f(point)` holds for some live point in the cells meeting the box
+    /// `[lo, hi]`. `near` are the slots of cells known to meet the box (no hashing for them).
     #[inline]
-    fn find_in_box<T>(
-        &self,
-        lo: DVec2,
-        hi: DVec2,
-        near: [usize; 3],
-        mut f: impl FnMut(usize, DVec2) -> Option<T>,
-    ) -> Option<T> {
+    fn any_in_box(&self, lo: DVec2, hi: DVec2, near: [u32; 3], f: impl Fn(DVec2) -> bool) -> bool {
         let (x0, y0) = self.coord(lo);
         let (x1, y1) = self.coord(hi);
-        let mut scan = |s: &Slot| -> Option<T> {
+        let scan = |s: &Slot| -> bool {
             let a = s.start as usize;
-            for k in a..a + s.live as usize {
-                if let Some(t) = f(self.ids[k] as usize, self.pts[k]) {
-                    return Some(t);
-                }
-            }
-            None
+            self.pts[a..a + s.live as usize].iter().any(|&p| f(p))
         };
         let span = (x1 - x0 + 1) as f64 * (y1 - y0 + 1) as f64;
         if span > 2.0 * self.cells as f64 {
-            for s in self.table.iter().filter(|s| s.key != Self::EMPTY) {
-                let (x, y) = Self::unpack(s.key);
-                if x >= x0 && x <= x1 && y >= y0 && y <= y1 {
-                    if let Some(t) = scan(s) {
-                        return Some(t);
-                    }
+            return self.table.iter().any(|s| {
+                if s.key == Self::EMPTY {
+                    return false;
                 }
-            }
-            return None;
+                let (x, y) = Self::unpack(s.key);
+                x >= x0 && x <= x1 && y >= y0 && y <= y1 && scan(s)
+            });
         }
-        let known = near.map(|v| self.slot_of[v] as usize);
+        let known = near.map(|h| h as usize);
         let known_keys = known.map(|h| self.table[h].key);
         for y in y0..=y1 {
             for x in x0..=x1 {
@@ -446,13 +560,13 @@ impl Grid {
                     None => self.find(x, y),
                 };
                 if let Some(h) = h {
-                    if let Some(t) = scan(&self.table[h]) {
-                        return Some(t);
+                    if scan(&self.table[h]) {
+                        return true;
                     }
                 }
             }
         }
-        None
+        false
     }
 }
 
@@ -512,6 +626,14 @@ impl IndexedHeap {
             }
             self.items[0].0 = w;
             self.sift_down(0);
+        }
+    }
+    /// Starts loading `v`'s entries of `pos` and `want` (see [`touch`]).
+    #[inline(always)]
+    fn warm(&self, v: usize) {
+        if let (Some(p), Some(w)) = (self.pos.get(v), self.want.get(v)) {
+            touch(p);
+            touch(w);
         }
     }
     /// Inserts `v` with `key`, or changes its key (an increase lazily, see the type docs).
@@ -624,10 +746,12 @@ const RETRY_ROUNDS: usize = 4;
 /// The priority queue of [`sequential`]: the minimum over (key, vertex id) of the queued
 /// vertices, kept in two parts:
 ///
-/// * `sorted`: the **initial** keys, sorted once (`sort_unstable` on `(u64, u32)` pairs,
-///   cache-friendly) and consumed front to back. An entry is stale iff its vertex was updated
-///   since (`updated[v]`) or removed — one array read, no heap work. Most vertices of a dense
-///   ring are removed with their initial key, so most pops cost O(1).
+/// * `sorted`: the **initial** keys, sorted once (`sort_unstable` on `(key, vertex, stamp)`
+///   triples, ordered by `(key, vertex)` as the vertex is unique; cache-friendly) and consumed
+///   front to back. An entry is stale iff its vertex's [`Node::stamp`] changed since (a
+///   neighbour was removed, so the key was recomputed) or the vertex was removed — one read of
+///   the vertex's node, which the topology check reads next anyway; no heap work. Most
+///   vertices of a dense ring are removed with their initial key, so most pops cost O(1).
 /// * `heap`: an [`IndexedHeap`] of the keys **recomputed** after a neighbour's removal
 ///   (changed in place, no stale entries), much smaller than the ring.
 ///
@@ -636,37 +760,47 @@ const RETRY_ROUNDS: usize = 4;
 /// previous implementation, a lazy `BinaryHeap` whose `pop` on ≈ 260 k entries took ≈ 28 % of
 /// the 100k benchmark).
 struct Queue {
-    sorted: Vec<(u64, u32)>,
+    sorted: Vec<(u64, u32, u32)>,
     pos: usize,
     heap: IndexedHeap,
-    /// The vertex's key was recomputed after the initial evaluation (its `sorted` entry is
-    /// stale).
-    updated: Vec<bool>,
 }
 
 impl Queue {
     /// Pops the smallest queued vertex.
     #[inline]
-    fn pop(&mut self, alive: &[bool]) -> Option<usize> {
+    fn pop(&mut self, ws: &Workspace) -> Option<usize> {
         // A removed vertex was popped first: from `sorted` (its entry is behind `pos`) or from
         // the heap (then it had been updated, so its `sorted` entry is stale). So an entry of
-        // a vertex that was never updated is live: one flag decides.
-        while let Some(&(_, v)) = self.sorted.get(self.pos) {
-            if !self.updated[v as usize] {
-                debug_assert!(alive[v as usize]);
+        // a vertex whose stamp is unchanged is live: one comparison decides.
+        while let Some(&(_, v, st)) = self.sorted.get(self.pos) {
+            if ws.stamp(v as usize) == st {
+                debug_assert!(ws.alive(v as usize));
                 break;
             }
             self.pos += 1;
         }
-        match (self.sorted.get(self.pos).copied(), self.heap.peek()) {
-            (Some(s), Some(h)) if h < s => self.heap.pop().map(|e| e.1 as usize),
-            (Some((_, v)), _) => {
+        let v = match (self.sorted.get(self.pos).copied(), self.heap.peek()) {
+            (Some((sk, sv, _)), Some(h)) if h < (sk, sv) => self.heap.pop().map(|e| e.1 as usize),
+            (Some((_, v, _)), _) => {
                 self.pos += 1;
                 Some(v as usize)
             }
             (None, Some(_)) => self.heap.pop().map(|e| e.1 as usize),
             (None, None) => None,
+        };
+        // prefetch the likely next candidates (no effect on the result): the next sorted
+        // entries (two stages: node, then what the topology check reads after it) and the
+        // heap's new root
+        if let Some(&(_, u, _)) = self.sorted.get(self.pos + 1) {
+            ws.warm(u as usize);
         }
+        if let Some(&(_, u, _)) = self.sorted.get(self.pos) {
+            ws.warm_around(u as usize);
+        }
+        if let Some(&(_, u)) = self.heap.items.first() {
+            ws.warm(u as usize);
+        }
+        v
     }
 }
 
@@ -683,16 +817,13 @@ where
 {
     let Stop::Below(threshold) = stop;
     let ids = ws.ring_ids(r);
-    let n = ws.pts.len();
-    // `stamp[v]` counts the key updates of `v`: a skipped vertex is re-queued in a retry round
-    // only if no neighbour change re-queued it since
-    let mut stamp = vec![0u32; n];
+    let n = ws.num_vertices();
     let mut sorted = Vec::with_capacity(ids.len());
     for &v in &ids {
         let (a, b, c) = ws.triangle(v);
         let k = key(a, b, c);
         if k < threshold {
-            sorted.push((order_bits(k), v as u32));
+            sorted.push((order_bits(k), v as u32, ws.stamp(v)));
         }
     }
     sorted.sort_unstable();
@@ -700,30 +831,37 @@ where
         sorted,
         pos: 0,
         heap: IndexedHeap::new(n),
-        updated: vec![false; n],
     };
     let mut removed = 0;
+    // skipped vertices with their stamps: one is re-queued in a retry round only if no
+    // neighbour change re-queued it since
     let mut skipped: Vec<(u32, u32)> = Vec::new();
     for _ in 0..=RETRY_ROUNDS {
         let mut removed_round = 0;
-        while let Some(v) = q.pop(&ws.alive) {
+        while let Some(v) = q.pop(ws) {
             // every queued key is below the threshold (only those are queued)
-            if ws.len[r] <= 3 {
+            if ws.ring_len(r) <= 3 {
                 break;
             }
+            // prefetch the heap positions the key updates will read (see `touch`)
+            let (ia, ic) = ws.neighbours(v);
+            q.heap.warm(ia);
+            q.heap.warm(ic);
             if !ws.can_remove(v) {
-                skipped.push((v as u32, stamp[v]));
+                skipped.push((v as u32, ws.stamp(v)));
                 continue;
             }
-            let (ia, ic) = ws.neighbours(v);
             ws.remove(v);
+            // second prefetch stage for the heap's root (its node was prefetched at the pop)
+            if let Some(&(_, u)) = q.heap.items.first() {
+                ws.warm_around(u as usize);
+            }
             removed += 1;
             removed_round += 1;
+            // `remove` bumped the stamps of `ia`, `ic`: their `sorted` entries are stale
             for w in [ia, ic] {
                 let (a, b, c) = ws.triangle(w);
                 let k = key(a, b, c);
-                stamp[w] = stamp[w].wrapping_add(1);
-                q.updated[w] = true;
                 if k < threshold {
                     q.heap.set(w, order_bits(k));
                 } else {
@@ -731,7 +869,7 @@ where
                 }
             }
         }
-        if removed_round == 0 || skipped.is_empty() || ws.len[r] <= 3 {
+        if removed_round == 0 || skipped.is_empty() || ws.ring_len(r) <= 3 {
             break;
         }
         q.heap.clear();
@@ -739,7 +877,7 @@ where
         for (v, st) in skipped.drain(..) {
             let v = v as usize;
             // still live and not re-queued since (a neighbour change would have done that)
-            if ws.alive[v] && stamp[v] == st {
+            if ws.alive(v) && ws.stamp(v) == st {
                 // its neighbours are those of its last key evaluation (unchanged stamp), so
                 // this recomputes exactly that key
                 let (a, b, c) = ws.triangle(v);
@@ -776,7 +914,7 @@ where
             .collect();
         let mut pass = 0;
         for v in cands {
-            if ws.len[r] <= 3 {
+            if ws.ring_len(r) <= 3 {
                 break;
             }
             if ws.can_remove(v) {
@@ -828,19 +966,19 @@ mod tests {
     /// triangle, tested against every live vertex with the exact predicate (no grid, no filter).
     fn brute_can_remove(ws: &Workspace, b: usize) -> bool {
         let r = ws.ring(b);
-        if !ws.alive[b] || ws.len[r] <= 3 {
+        if !ws.alive(b) || ws.ring_len(r) <= 3 {
             return false;
         }
         let (ia, ic) = ws.neighbours(b);
-        let (a, pb, c) = (ws.pts[ia], ws.pts[b], ws.pts[ic]);
-        if ws.len[r] == 4 && orient2d(a, c, ws.pts[ws.next[ic] as usize]) == 0.0 {
+        let (a, pb, c) = (ws.point(ia), ws.point(b), ws.point(ic));
+        if ws.ring_len(r) == 4 && orient2d(a, c, ws.point(ws.neighbours(ic).1)) == 0.0 {
             return false;
         }
         let o = orient2d(a, pb, c);
-        (0..ws.pts.len())
-            .filter(|&v| ws.alive[v] && v != ia && v != b && v != ic)
+        (0..ws.num_vertices())
+            .filter(|&v| ws.alive(v) && v != ia && v != b && v != ic)
             .all(|v| {
-                let p = ws.pts[v];
+                let p = ws.point(v);
                 let inside = if o != 0.0 {
                     let s = [orient2d(a, pb, p), orient2d(pb, c, p), orient2d(c, a, p)];
                     s.iter().all(|&x| x * o >= 0.0)
@@ -893,13 +1031,13 @@ mod tests {
             let hole: Vec<DVec2> = vec![v(-1.0, -1.0), v(1.5, -1.0), v(0.0, 1.5)];
             let mut ws = Workspace::new(&[ring, hole]);
             for step in order {
-                for b in 0..ws.pts.len() {
-                    if ws.alive[b] {
+                for b in 0..ws.num_vertices() {
+                    if ws.alive(b) {
                         prop_assert_eq!(ws.can_remove(b), brute_can_remove(&ws, b), "vertex {}", b);
                     }
                 }
-                let b = step as usize % ws.pts.len();
-                if ws.alive[b] && ws.can_remove(b) {
+                let b = step as usize % ws.num_vertices();
+                if ws.alive(b) && ws.can_remove(b) {
                     ws.remove(b);
                 }
             }

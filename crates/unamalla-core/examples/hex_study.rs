@@ -7,6 +7,7 @@
 //! cargo run --release -p unamalla-core --example hex_study -- a-variants [case]
 //! cargo run --release -p unamalla-core --example hex_study -- hessian [cells] [runs]
 //! cargo run --release -p unamalla-core --example hex_study -- b-study <case> <mu0> <mu_min> <iters> [m,n,p]
+//! cargo run --release -p unamalla-core --example hex_study -- b-trace <case> <m,n,p|-> <mu0> <factor> <iters> <bj|mg|jacobi|none> <cg_max> [mu_min]
 //! ```
 //!
 //! * `a-time`: best-of-`runs` wall time of Algorithm A alone (the `run_hex` driver with the
@@ -18,6 +19,10 @@
 //!   analysis of the interior faces still at `|cos| ≥ 10⁻²`: their position in the interior
 //!   block (distance in cells to the block's surface) and the ratio of the reported measure
 //!   (max over the four relabellings) to the penalized cosine (first vertex only).
+//! * `b-trace`: Algorithm A (defaults), then a hand-run Algorithm B loop with the given μ₀,
+//!   μ factor, iterations per step, CG preconditioner and CG iteration cap; prints per μ step
+//!   the solver iterations, inner CG iterations, evaluations, stop reason, wall/CPU seconds
+//!   and the non-hexahedral count (where B's time goes).
 //! * `hessian`: one Hessian refresh of `H_ω` on a folded `cells³` grid, node-block against
 //!   the reference assembly (best of `runs`).
 
@@ -398,6 +403,107 @@ fn b_study(
     }
 }
 
+/// Options of one `b-trace` run.
+struct BTrace {
+    mu0: f64,
+    factor: f64,
+    iters: usize,
+    pre: unamalla_core::optim::Preconditioner,
+    cg_max: usize,
+    mu_min: f64,
+}
+
+/// Algorithm A (defaults) on `case`, then a hand-run Algorithm B loop printing, per μ step,
+/// the solver iterations, inner CG iterations, function evaluations, stop reason, seconds
+/// and the non-hexahedral count; the totals at the end.
+fn b_trace(case: HexCase, dims: Option<(usize, usize, usize)>, o: &BTrace) {
+    let dims = dims.unwrap_or_else(|| case.default_size());
+    let mut g = case.initial_grid(dims).expect("grid");
+    case.default_perturbation(dims)
+        .apply(&mut g, 1)
+        .expect("perturbation");
+    let opts = HexRunOptions {
+        algorithm: HexAlgorithm::A,
+        ..HexRunOptions::default()
+    };
+    let r = run_hex(&mut g, &opts, &mut NullObserver).expect("A");
+    let scaling = Scaling3::Parametric {
+        m: dims.0,
+        n: dims.1,
+        p: dims.2,
+    };
+    let topo = Arc::new(HexTopology::from_mesh(&g).expect("topology"));
+    let mut x = topo.initial_x();
+    let probe = HexFunctional::h_omega(topo.clone(), 1.0, scaling).expect("probe");
+    let mut obs = NullObserver;
+    let mut session = Session::new(&probe, &x, &mut obs);
+    let c0 = session.convexity(&probe, &x);
+    let omega = 1e-8 * c0.mean;
+    session.set_phase(Phase::Homotopic);
+    session.monitor.omega = Some(omega);
+    let mut p = HexFunctional::h_omega(topo.clone(), omega, scaling).expect("functional");
+    let solver = SolverOptions {
+        max_iter: o.iters,
+        ftol: 1e-8,
+        gtol: 1e-4,
+        preconditioner: o.pre,
+        cg_max_iter: o.cg_max,
+        ..SolverOptions::default()
+    };
+    println!(
+        "{} {}x{}x{}: A {} it, NH after A {}; B μ₀ {:e} ×{} ≤{} it/step, {:?}, cg_max {}",
+        case.name(),
+        dims.0,
+        dims.1,
+        dims.2,
+        r.iterations,
+        r.non_hex_interior_cells,
+        o.mu0,
+        o.factor,
+        o.iters,
+        o.pre,
+        o.cg_max
+    );
+    println!(
+        "{:>10} {:>5} {:>6} {:>6} {:>8} {:>8} {:>6} {:>10}  reason",
+        "μ", "it", "CG", "fevals", "wall s", "CPU s", "NH", "max|k|"
+    );
+    let (t0, cpu0) = (Instant::now(), cpu_seconds());
+    let (mut it, mut cg, mut fe) = (0, 0, 0);
+    let mut mu = o.mu0;
+    while mu > o.mu_min {
+        session.monitor.mu = Some(mu);
+        p.set_coplanarity(Some(1.0 / (2.0 * mu))).expect("C");
+        let (t1, c1) = (Instant::now(), cpu_seconds());
+        let s = minimize_with(&p, &mut x, &solver, &mut session, None).expect("B step");
+        let (mx, nh) = topo.planarity_report(&x, 1e-2);
+        println!(
+            "{:>10.1e} {:>5} {:>6} {:>6} {:>8.3} {:>8.2} {:>6} {:>10.2e}  {:?}",
+            mu,
+            s.iterations,
+            s.cg_iterations,
+            s.fevals,
+            t1.elapsed().as_secs_f64(),
+            cpu_seconds() - c1,
+            nh,
+            mx,
+            s.reason
+        );
+        it += s.iterations;
+        cg += s.cg_iterations;
+        fe += s.fevals;
+        mu *= o.factor;
+    }
+    let c = session.convexity(&probe, &x);
+    let (mx, nh) = topo.planarity_report(&x, 1e-2);
+    println!(
+        "total: {it} it, {cg} CG, {fe} fevals, {:.2} s wall, {:.2} s CPU; NH {nh}, max|k| {mx:.2e}, V>0 everywhere: {}",
+        t0.elapsed().as_secs_f64(),
+        cpu_seconds() - cpu0,
+        c.min > 0.0
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mode = args.first().map(String::as_str).unwrap_or("a-time");
@@ -430,6 +536,32 @@ fn main() {
                 dims,
             );
         }
-        other => eprintln!("unknown mode {other}: a-time | a-variants | hessian | b-study"),
+        "b-trace" => {
+            // b-trace <case> <m,n,p|-> <mu0> <factor> <iters> <bj|mg|jacobi|none> <cg_max>
+            let num = |i: usize, d: f64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+            let dims = args.get(2).filter(|s| s.as_str() != "-").map(|s| {
+                let v: Vec<usize> = s.split(',').map(|t| t.parse().expect("size")).collect();
+                (v[0], v[1], v[2])
+            });
+            use unamalla_core::optim::Preconditioner as Pc;
+            let pre = match args.get(6).map(String::as_str).unwrap_or("bj") {
+                "mg" => Pc::Multigrid,
+                "jacobi" => Pc::Jacobi,
+                "none" => Pc::None,
+                _ => Pc::BlockJacobi,
+            };
+            let o = BTrace {
+                mu0: num(3, 0.1),
+                factor: num(4, 0.1),
+                iters: num(5, 50.0) as usize,
+                pre,
+                cg_max: num(7, 200.0) as usize,
+                mu_min: num(8, 1e-12),
+            };
+            b_trace(case(), dims, &o);
+        }
+        other => {
+            eprintln!("unknown mode {other}: a-time | a-variants | hessian | b-study | b-trace")
+        }
     }
 }

@@ -40,6 +40,7 @@ pub mod pde;
 pub mod pipeline;
 pub mod render;
 pub mod single_block;
+pub mod untangle;
 
 pub use unamalla_bspline as bspline;
 pub use unamalla_compat_ilp as compat_ilp;

@@ -23,11 +23,11 @@
 //! 7. **smooth** the merged mesh with `F = (1−σ)·w·F_AO + σ·H_ω` (seed 000 (6.8)/(6.9)) with the
 //!    ε-convexity guarantee of `unamalla-optim`; region boundary nodes are fixed, **cut nodes are
 //!    free**. The thesis smooths block by block and then each block with its neighbours. We
-//!    first untangle every folded block on its own, with its boundary fixed, all blocks in
-//!    parallel ([`unamalla_optim::smooth_each`]; small problems need far fewer iterations), then
+//!    first untangle the folded cells in local patches of the merged mesh (the folded cells and
+//!    `r` layers around them, across block boundaries, `r` growing until they are convex;
+//!    patches in parallel, [`crate::untangle`]; small problems need far fewer iterations), then
 //!    run one global optimization over the whole merged mesh with the same functional (the limit
-//!    of the thesis's sequence), which starts convex wherever the blocks could be untangled
-//!    alone.
+//!    of the thesis's sequence), which starts convex wherever the patches could be untangled.
 //! 8. **report** quality ([`QualityReport`]) and fidelity (area change, Hausdorff distance of
 //!    the mesh boundary to the input region).
 //!
@@ -61,7 +61,7 @@ use unamalla_mesh::{
     tfi2, BlockMesh2, DVec2, HasNodes, HasQuadCells, Region, StructuredGrid2, TfiParams,
 };
 use unamalla_optim::monitor::{Control, Monitor, NullObserver, Observer};
-use unamalla_optim::{smooth, smooth_each, SmoothOptions};
+use unamalla_optim::{smooth, SmoothOptions};
 
 use crate::CoreError;
 
@@ -308,7 +308,8 @@ impl Mesher {
         self.boundary_density = w;
         self
     }
-    /// Wall-time budget of the smoothing stage in seconds (default 20). Once it is spent and
+    /// Wall-time budget of the global smoothing run in seconds (default 20; the local
+    /// untangling before it is bounded by iteration limits instead). Once it is spent and
     /// the mesh is convex (Inocon = 0) the optimizer is stopped and its current iterate — convex,
     /// by the safeguard — is kept; a mesh that is still being untangled gets up to three times
     /// the budget. The report's `smoothing` field then says "STOP by user".
@@ -503,21 +504,32 @@ impl Mesher {
             *density = self.boundary_density;
         }
         let budget = self.smooth_budget;
-        let started = Instant::now();
-        // 7a. untangle folded blocks one by one, each with its own boundary fixed, in
-        // parallel: small problems converge in far fewer iterations than the global one, and
-        // the global run below then starts convex (or nearly so)
-        // (at most half the budget: blocks that cannot be untangled with their boundary fixed
-        // are left to the global run, where cut nodes move)
-        let deadline = started + std::time::Duration::from_secs_f64(0.5 * budget.max(0.0));
-        let folded = |g: &StructuredGrid2| {
-            g.m() > 2 && g.n() > 2 && !unamalla_mesh::quality::non_convex_cells(g).is_empty()
-        };
-        let per_block = smooth_each(mesh.blocks_mut(), folded, &sopts, Some(deadline));
-        for r in per_block.into_iter().flatten() {
-            r?;
+        // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
+        // block boundaries ([`crate::untangle`]): small problems converge in far fewer
+        // iterations than the global one, the work is bounded by iteration limits (not
+        // wall-clock time, so the result does not depend on the load), and the global run
+        // below then starts convex (or nearly so)
+        let t_patch = Instant::now();
+        let patches = crate::untangle::untangle_patches(
+            mesh.global_mut(),
+            &sopts,
+            &crate::untangle::DEFAULT_PATCH_RADII,
+        )?;
+        if patches.before > 0 {
+            mesh.sync_blocks();
+            let msg = format!(
+                "untangled {} → {} non-convex cells in {} local patch(es) (radius ≤ {}, {} iterations, {:.2} s)",
+                patches.before,
+                patches.after,
+                patches.patches,
+                patches.max_radius,
+                patches.iterations,
+                t_patch.elapsed().as_secs_f64()
+            );
+            self.stage(Stage::Smooth, &msg);
         }
-        mesh.sync_global();
+        // 7b. the global run; the budget counts from here
+        let started = Instant::now();
         let mut budgeted = |m: &Monitor| {
             if observer.observe(m) == Control::Stop {
                 return Control::Stop;

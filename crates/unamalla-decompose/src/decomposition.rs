@@ -278,6 +278,51 @@ impl Decomposition {
                 || crate::concavity::critical_angles(&b.ring, tol.theta_minus).is_empty())
     }
 
+    /// **Cut joints**: block vertices that do not lie on the region boundary (within
+    /// 10⁻⁹ of the bounding-box diagonal), sorted by coordinates, each listed once.
+    ///
+    /// In a decomposition without joints every cut ends on the region boundary, so the
+    /// blocks' structured grids meet along whole cuts and every interior mesh node has
+    /// valence 4. A joint is where a cut was split by the triangle-block rule (a corner placed
+    /// inside a cut, issue #6): one block has a corner there while its neighbour sees a
+    /// straight side, and the merged mesh gets an interior node of valence 3 and one of
+    /// valence 5. The automatic decomposition avoids them (module `repair`); an empty result
+    /// is the check for "no corner strictly inside a cut".
+    ///
+    /// ```
+    /// # use unamalla_mesh::{DVec2, Region};
+    /// # use unamalla_decompose::{decompose, DecomposeOptions};
+    /// let square = Region::new(
+    ///     vec![DVec2::new(0., 0.), DVec2::new(1., 0.), DVec2::new(1., 1.), DVec2::new(0., 1.)],
+    ///     vec![],
+    /// ).unwrap();
+    /// let d = decompose(&square, &DecomposeOptions::default()).unwrap();
+    /// assert!(d.cut_joints(&square).is_empty());
+    /// ```
+    pub fn cut_joints(&self, region: &Region) -> Vec<DVec2> {
+        let tol = boundary_tol(region);
+        let mut out: Vec<DVec2> = Vec::new();
+        for b in &self.blocks {
+            for &p in &b.ring {
+                let on_boundary = region.rings().any(|r| {
+                    let q = r.points();
+                    (0..q.len()).any(|k| {
+                        unamalla_mesh::geometry::point_segment_distance(
+                            p,
+                            q[k],
+                            q[(k + 1) % q.len()],
+                        ) <= tol
+                    })
+                });
+                if !on_boundary && !out.contains(&p) {
+                    out.push(p);
+                }
+            }
+        }
+        out.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        out
+    }
+
     /// Smallest corner angle over all blocks (radians).
     pub fn min_corner_angle(&self) -> f64 {
         self.blocks

@@ -108,6 +108,13 @@
 //! block, so a region (or a union of blocks) with fewer than four usable vertices can never be
 //! cut into blocks with four usable corners each — a triangle stays a triangle block.
 //!
+//! **No corner inside a cut** (issue #6, third step of the repair): a block that would still
+//! need a point inside a cut for the triangle-block rule (bounded by cuts where its corners
+//! must go, fewer than four usable vertices) is split or merged and re-split with a relaxed
+//! acceptance (a critical angle or a non-convex block is accepted, a cut joint is not).
+//! [`Decomposition::cut_joints`] lists block vertices off the region boundary (empty for
+//! every fixture region, tested).
+//!
 //! **Triangle-block rule and split cuts.** Blocks with three vertices or fewer than four
 //! corner-like vertices get the triangle-block rule, inserting on original boundary edges only
 //! when possible; otherwise a block with four non-reflex vertices takes its corners among them

@@ -8,8 +8,11 @@
 //! merge pass, by the first of (the same is tried for blocks that kept a critical angle — mostly
 //! at the end of a cut made by a relaxed tier — or stayed non-convex):
 //!
-//! 1. **a split**: a cut inside the block (from a vertex to a vertex or to the foot of the
-//!    perpendicular on an original-boundary edge; exact admissibility, no new angle below θ₋)
+//! 1. **a split**: a cut inside the block (from a vertex to a vertex, to the foot of the
+//!    perpendicular on an original-boundary edge; only if none of these works, also to the
+//!    quarter points ¼, ½, ¾ of such an edge — so that a cut meeting the boundary at a critical
+//!    angle at a vertex can end inside the edge instead; exact admissibility, no new angle
+//!    below θ₋)
 //!    such that both children are *good* — four usable corners, approximately convex
 //!    (criteria 1–4), no critical angle, area at least a tenth of the negligible area;
 //! 2. **a merge with a neighbour** across one cut (the two blocks share exactly that cut's two
@@ -22,10 +25,24 @@
 //! a file are never removed. Blocks that stay without four usable corners (three-vertex blocks:
 //! a triangle cannot be split into quadrilaterals by straight cuts without an interior node of
 //! valence 3) get the triangle-block rule of seed 000 digest §4.2 afterwards.
+//!
+//! 3. **No corner inside a cut** (issue #6, `Builder::joint_pass`): a block that is bounded by
+//!    cuts on the sides where it would need corners and has fewer than four usable vertices
+//!    (maryland's "block 4" at the pipeline defaults: a quadrilateral of four cuts with a
+//!    reflex vertex and a 30° vertex) could only get the triangle-block rule by inserting points
+//!    **inside cuts** — each such point is a cut joint, an interior mesh node where one grid
+//!    has a corner and the neighbour a straight side (valence 3 and 5). When steps 1–2 find no
+//!    repair into good blocks, the block is split, or merged with a neighbour (and the union
+//!    re-split), by the same candidates with a relaxed acceptance: every resulting block must
+//!    take its corners without a point inside a cut, and costs `grade + F` with grade 0 for a
+//!    good block, 1 for an approximately convex one with a critical angle (or a triangle block
+//!    served on the original boundary), 3 for a non-convex one. A singular mesh node is worse
+//!    than a less admissible block. [`Decomposition::cut_joints`](crate::Decomposition::cut_joints)
+//!    lists the joints that remain (none on the fixture regions, tested).
 
 use unamalla_mesh::DVec2;
 
-use crate::auto::Builder;
+use crate::auto::{needs_cut_point, triangle_plan, Builder};
 use crate::concavity::{concavity, critical_angles};
 use crate::corners::{quad_fit, select_corners};
 use crate::decomposition::{Step, TreeNode};
@@ -61,6 +78,10 @@ pub(crate) fn union_ring(a: &Ring, ea: usize, b: &Ring, eb: usize) -> Option<Rin
 
 /// A split candidate: score, the two children (new cut tagged [`TMP_CUT`]), cut endpoints.
 type Split = (f64, Ring, Ring, (DVec2, DVec2));
+
+/// A merge candidate: score, neighbour slot, shared cut, split of the union (`None`: the union
+/// is kept whole), union.
+type Merge = (f64, usize, usize, Option<Split>, Ring);
 
 impl Builder<'_> {
     /// Four usable corners (see the module documentation).
@@ -101,6 +122,32 @@ impl Builder<'_> {
 
     /// The best cut splitting `ring` into two good blocks.
     fn best_split(&self, ring: &Ring) -> Option<Split> {
+        self.best_split_by(ring, &|r: &Ring| self.good(r).then(|| quad_fit(&r.pts)))
+    }
+
+    /// The best cut splitting `ring` into two blocks that `accept` takes; `accept` returns the
+    /// cost F of a child (its corner score, plus a grade penalty in the relaxed pass) and the
+    /// split scores `½·max(F₁, F₂) + ¼·(F₁ + F₂) + w_a·ḡ + w_l·ℓ/√A`.
+    ///
+    /// The quarter points of the original-boundary edges are offered only when the vertices
+    /// and feet give no acceptable split (so they add repairs without changing the ones that
+    /// worked before), and only with [`DecomposeOptions::edge_point_cuts`](crate::DecomposeOptions::edge_point_cuts).
+    fn best_split_by(&self, ring: &Ring, accept: &dyn Fn(&Ring) -> Option<f64>) -> Option<Split> {
+        self.best_split_with(ring, accept, false).or_else(|| {
+            self.opts
+                .edge_point_cuts
+                .then(|| self.best_split_with(ring, accept, true))
+                .flatten()
+        })
+    }
+
+    /// [`Builder::best_split_by`] with or without the quarter-point targets.
+    fn best_split_with(
+        &self,
+        ring: &Ring,
+        accept: &dyn Fn(&Ring) -> Option<f64>,
+        quarter_points: bool,
+    ) -> Option<Split> {
         let piece = Piece {
             outer: ring.clone(),
             holes: Vec::new(),
@@ -122,6 +169,22 @@ impl Builder<'_> {
             let near = |j: usize| j == i || j == (i + 1) % n || j == (i + n - 1) % n;
             let mut t = Vec::new();
             Self::targets_on_ring(&piece, 0, p, &near, &mut t);
+            // also the quarter points of the original-boundary edges: a cut that met the
+            // boundary at a critical angle at a vertex can end inside the edge instead, where
+            // the foot of the perpendicular is not on the edge (issue #6)
+            for e in (0..n).filter(|_| quarter_points) {
+                let e2 = (e + 1) % n;
+                if near(e) || near(e2) || !matches!(ring.tags[e], Tag::Boundary(_)) {
+                    continue;
+                }
+                let (a, b) = (ring.p(e), ring.p(e2));
+                for f in [0.25, 0.5, 0.75] {
+                    t.push(End {
+                        ring: 0,
+                        pos: Pos::OnEdge(e, a + f * (b - a)),
+                    });
+                }
+            }
             for e2 in t {
                 if let Pos::Vertex(j) = e2.pos {
                     if j < i {
@@ -158,10 +221,9 @@ impl Builder<'_> {
             let mut m = piece.clone();
             let (x, y) = m.insert_ends(e1, e2);
             let (a, b) = m.split(x, y, TMP_CUT);
-            if !self.good(&a.outer) || !self.good(&b.outer) {
+            let (Some(fa), Some(fb)) = (accept(&a.outer), accept(&b.outer)) else {
                 continue;
-            }
-            let (fa, fb) = (quad_fit(&a.outer.pts), quad_fit(&b.outer.pts));
+            };
             let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
             if best.as_ref().is_none_or(|b| s < b.0) {
                 best = Some((s, a.outer, b.outer, (m.outer.p(x), m.outer.p(y))));
@@ -219,6 +281,172 @@ impl Builder<'_> {
         node.block = None;
     }
 
+    /// The best merge of block slot `k` with a neighbour across one live, unprotected cut
+    /// (the two blocks share exactly that cut's endpoints): the union alone if `accept` takes
+    /// it, else the best split of the union by `accept`. Returns (score, neighbour slot, cut,
+    /// split or `None` for the union alone, union).
+    fn best_merge(
+        &self,
+        slot: &[Option<Ring>],
+        k: usize,
+        alive: &[bool],
+        accept: &dyn Fn(&Ring) -> Option<f64>,
+    ) -> Option<Merge> {
+        let r = slot[k].as_ref()?;
+        let mut best: Option<Merge> = None;
+        for (e, t) in r.tags.iter().enumerate() {
+            let Tag::Cut(c) = *t else { continue };
+            if c < self.protected_cuts || !alive.get(c).copied().unwrap_or(false) {
+                continue;
+            }
+            let Some((j, f)) = slot.iter().enumerate().find_map(|(j, o)| {
+                let o = o.as_ref()?;
+                if j == k {
+                    return None;
+                }
+                o.tags
+                    .iter()
+                    .position(|x| *x == Tag::Cut(c))
+                    .map(|f| (j, f))
+            }) else {
+                continue;
+            };
+            let Some(other) = slot[j].as_ref() else {
+                continue;
+            };
+            if r.pts.iter().filter(|p| other.pts.contains(p)).count() != 2 {
+                continue;
+            }
+            let Some(u) = union_ring(r, e, other, f) else {
+                continue;
+            };
+            if crate::geom::signed_area(&u.pts) <= 0.0 {
+                continue;
+            }
+            let option = match accept(&u) {
+                Some(cost) => Some((cost, None)),
+                None => self.best_split_by(&u, accept).map(|s| (s.0, Some(s))),
+            };
+            if let Some((s, split)) = option {
+                let key = u.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
+                let better = best.as_ref().is_none_or(|b| {
+                    s < b.0 - 1e-12
+                        || ((s - b.0).abs() <= 1e-12 && {
+                            let kb = b.4.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
+                            (key.x, key.y) < (kb.x, kb.y)
+                        })
+                });
+                if better {
+                    best = Some((s, j, c, split, u));
+                }
+            }
+        }
+        best
+    }
+
+    /// Cost of a block for the **relaxed** repair of blocks that would get a corner inside a
+    /// cut: `None` if it would itself need one (or has no usable corners at all, or is
+    /// negligible); else `grade + F` with F its corner score and grade 0 for a good block, 1
+    /// for an approximately convex block that keeps a critical angle or is a triangle block
+    /// served on the original boundary, 3 for a block that is not approximately convex.
+    fn relaxed_cost(&self, ring: &Ring) -> Option<f64> {
+        let tol = &self.opts.tolerances;
+        if crate::geom::signed_area(&ring.pts) < 0.1 * self.min_area {
+            return None;
+        }
+        if self.good(ring) {
+            return Some(quad_fit(&ring.pts));
+        }
+        let triangle = triangle_plan(ring, tol.theta_minus, self.opts);
+        if triangle.as_ref().is_some_and(|t| t.1) {
+            return None;
+        }
+        if triangle.is_none() && !self.usable(&ring.pts) {
+            return None;
+        }
+        let grade = if concavity(&ring.pts).approximately_convex(tol) {
+            1.0
+        } else {
+            3.0
+        };
+        Some(grade + quad_fit(&ring.pts))
+    }
+
+    /// Applies a merge found by [`Builder::best_merge`] to slots `k` and `j`.
+    fn apply_merge(
+        &mut self,
+        slot: &mut [Option<Ring>],
+        owner: &mut [usize],
+        alive: &mut Vec<bool>,
+        k: usize,
+        m: Merge,
+    ) {
+        let (_, j, c, split, u) = m;
+        alive[c] = false;
+        match split {
+            None => {
+                slot[k] = Some(u);
+                slot[j] = None;
+                owner[j] = k;
+            }
+            Some((_, a, b, ends)) => {
+                let (a, b, _) = self.commit_split(a, b, ends);
+                alive.push(true);
+                slot[k] = Some(a);
+                slot[j] = Some(b);
+            }
+        }
+    }
+
+    /// Step 3 of the repair (issue #6): every block that would still get a corner inside a
+    /// cut (a cut joint: a block bounded by cuts without four usable corners, whose
+    /// triangle-block rule cannot insert on the original boundary) is split, or merged with a
+    /// neighbour (and the union re-split), into blocks that take their corners without one —
+    /// accepting a critical angle or a non-convex block ([`Builder::relaxed_cost`]): a
+    /// singular mesh node is worse than a less admissible block. Split alone or merge, the
+    /// lower score wins.
+    fn joint_pass(
+        &mut self,
+        slot: &mut Vec<Option<Ring>>,
+        owner: &mut Vec<usize>,
+        alive: &mut Vec<bool>,
+    ) {
+        // relaxed: a block that would still get a corner inside a cut (a cut joint) is
+        // split, or merged (and re-split), into blocks that can take their corners without one,
+        // accepting a critical angle or a non-convex block (relaxed_cost) — a singular mesh
+        // node is worse than a less admissible block
+        let theta = self.opts.tolerances.theta_minus;
+        let mut k = 0;
+        let mut budget = 2 * slot.len() + 8;
+        while k < slot.len() && budget > 0 {
+            let Some(r) = slot[k].clone() else {
+                k += 1;
+                continue;
+            };
+            if !needs_cut_point(&r, theta, self.opts) {
+                k += 1;
+                continue;
+            }
+            budget -= 1;
+            let relaxed = |u: &Ring| self.relaxed_cost(u);
+            let alone = self.best_split_by(&r, &relaxed);
+            let merge = self.best_merge(slot, k, alive, &relaxed);
+            match (alone, merge) {
+                (Some(s), m) if m.as_ref().is_none_or(|m| s.0 <= m.0) => {
+                    let (_, a, b, ends) = s;
+                    let (a, b, id) = self.commit_split(a, b, ends);
+                    alive.push(true);
+                    slot[k] = Some(a);
+                    slot.push(Some(b));
+                    owner.push(slot.len() - 1);
+                    self.branch_leaf(k, slot.len() - 1, id);
+                }
+                (_, Some(m)) => self.apply_merge(slot, owner, alive, k, m),
+                _ => k += 1,
+            }
+        }
+    }
+
     /// The corner-repair pass (module documentation). `rings[k]` is block `k`; the tree's leaf
     /// nodes point to block ids. Returns the new blocks (cuts and tree renumbered).
     pub(crate) fn repair_pass(&mut self, rings: Vec<Ring>) -> Vec<Ring> {
@@ -248,72 +476,13 @@ impl Builder<'_> {
                 continue;
             }
             // 2. merge with a neighbour, possibly followed by a split
-            let mut best: Option<(f64, usize, usize, Option<Split>, Ring)> = None;
-            for (e, t) in r.tags.iter().enumerate() {
-                let Tag::Cut(c) = *t else { continue };
-                if c < self.protected_cuts || !alive.get(c).copied().unwrap_or(false) {
-                    continue;
-                }
-                let Some((j, f)) = slot.iter().enumerate().find_map(|(j, o)| {
-                    let o = o.as_ref()?;
-                    if j == k {
-                        return None;
-                    }
-                    o.tags
-                        .iter()
-                        .position(|x| *x == Tag::Cut(c))
-                        .map(|f| (j, f))
-                }) else {
-                    continue;
-                };
-                let Some(other) = slot[j].as_ref() else {
-                    continue;
-                };
-                if r.pts.iter().filter(|p| other.pts.contains(p)).count() != 2 {
-                    continue;
-                }
-                let Some(u) = union_ring(&r, e, other, f) else {
-                    continue;
-                };
-                if crate::geom::signed_area(&u.pts) <= 0.0 {
-                    continue;
-                }
-                let option = if self.good(&u) {
-                    Some((quad_fit(&u.pts), None))
-                } else {
-                    self.best_split(&u).map(|s| (s.0, Some(s)))
-                };
-                if let Some((s, split)) = option {
-                    let key = u.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
-                    let better = best.as_ref().is_none_or(|b| {
-                        s < b.0 - 1e-12
-                            || ((s - b.0).abs() <= 1e-12 && {
-                                let kb = b.4.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
-                                (key.x, key.y) < (kb.x, kb.y)
-                            })
-                    });
-                    if better {
-                        best = Some((s, j, c, split, u));
-                    }
-                }
-            }
-            match best {
-                Some((_, j, c, None, u)) => {
-                    alive[c] = false;
-                    slot[k] = Some(u);
-                    slot[j] = None;
-                    owner[j] = k;
-                }
-                Some((_, j, c, Some((_, a, b, ends)), _)) => {
-                    alive[c] = false;
-                    let (a, b, _) = self.commit_split(a, b, ends);
-                    alive.push(true);
-                    slot[k] = Some(a);
-                    slot[j] = Some(b);
-                }
+            let good = |u: &Ring| self.good(u).then(|| quad_fit(&u.pts));
+            match self.best_merge(&slot, k, &alive, &good) {
+                Some(m) => self.apply_merge(&mut slot, &mut owner, &mut alive, k, m),
                 None => k += 1,
             }
         }
+        self.joint_pass(&mut slot, &mut owner, &mut alive);
         self.renumber(slot, owner, alive)
     }
 
@@ -501,5 +670,54 @@ mod tests {
         assert_eq!(out.len(), 1);
         assert!(b.cuts.is_empty());
         assert!((crate::geom::signed_area(&out[0].pts) - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn triangle_of_cuts_gets_no_corner_inside_a_cut() {
+        // 10 × 10 square cut by the triangle of cuts P = (5,0), Q = (10,6), R = (0,6) (the
+        // maryland situation of issue #6: a piece bounded by cuts only). Its angles are
+        // 2·atan(5/6) = 79.6° at P and atan(6/5) = 50.2° at Q and R (no critical angle), so the
+        // triangle-block rule would put its fourth corner at the midpoint of its longest side —
+        // inside a cut (a valence-3 node in the mesh). The joint pass must merge it away.
+        let region =
+            Region::new(vec![v(0., 0.), v(10., 0.), v(10., 10.), v(0., 10.)], vec![]).unwrap();
+        let opts = DecomposeOptions::default();
+        let mut b = Builder::new(&region, &opts);
+        b.cuts = vec![
+            (v(5., 0.), v(10., 6.)),
+            (v(10., 6.), v(0., 6.)),
+            (v(0., 6.), v(5., 0.)),
+        ];
+        let (c0, c1, c2) = (Tag::Cut(0), Tag::Cut(1), Tag::Cut(2));
+        let t = ring(&[(5., 0.), (10., 6.), (0., 6.)], &[c0, c1, c2]);
+        let theta = opts.tolerances.theta_minus;
+        assert!(needs_cut_point(&t, theta, &opts));
+        let mut slot = vec![
+            Some(t),
+            Some(ring(&[(5., 0.), (10., 0.), (10., 6.)], &[B, B, c0])),
+            Some(ring(
+                &[(10., 6.), (10., 10.), (0., 10.), (0., 6.)],
+                &[B, B, B, c1],
+            )),
+            Some(ring(&[(0., 0.), (5., 0.), (0., 6.)], &[B, c2, B])),
+        ];
+        // the outer blocks are served on the boundary (triangles with two boundary edges,
+        // the rectangle-like top block has four usable corners)
+        for r in slot.iter().skip(1).flatten() {
+            assert!(!needs_cut_point(r, theta, &opts), "{:?}", r.pts);
+        }
+        let mut owner: Vec<usize> = (0..4).collect();
+        let mut alive = vec![true; 3];
+        b.joint_pass(&mut slot, &mut owner, &mut alive);
+        let out = b.renumber(slot, owner, alive);
+        // one cut fewer at least, no block needs a point inside a cut, area 100 preserved
+        assert!(out.len() <= 3, "{} blocks", out.len());
+        assert_eq!(b.cuts.len(), out.len() - 1);
+        let area: f64 = out.iter().map(|r| crate::geom::signed_area(&r.pts)).sum();
+        assert!((area - 100.0).abs() < 1e-9, "area {area}");
+        for r in &out {
+            assert!(!needs_cut_point(r, theta, &opts), "{:?}", r.pts);
+            assert!(r.tags.iter().any(|t| matches!(t, Tag::Boundary(_))));
+        }
     }
 }

@@ -25,6 +25,7 @@ fn all_fixture_regions_decompose() {
             .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         d.validate(&region).unwrap();
         assert_eq!(d.graph_cycles(), region.holes().len(), "{}", f.display());
+        assert!(d.cut_joints(&region).is_empty(), "{}", f.display());
         let admissible = (0..d.blocks.len())
             .filter(|&b| d.block_admissible(b, &tol))
             .count();
@@ -85,6 +86,10 @@ fn pipeline_regions_meet_the_corner_rules() {
         let d = decompose(&region, &DecomposeOptions::default())
             .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         assert_eq!(d.graph_cycles(), region.holes().len(), "{}", f.display());
+        // issue #6: no corner inside a cut — every block vertex lies on the region boundary
+        // (maryland had two such joints, the two interior singularities of its mesh)
+        let joints = d.cut_joints(&region);
+        assert!(joints.is_empty(), "{}: cut joints {joints:?}", f.display());
         // known remaining case: one last-resort straight corner in norway-mainland (see
         // docs/results.md); every other quadrilateral block corner is below 170°
         straight += d

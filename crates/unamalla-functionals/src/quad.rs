@@ -785,6 +785,9 @@ macro_rules! with_plan {
     };
 }
 
+// After `with_plan!` (textual macro scope): the PSD-projected model Hessian (issue #4).
+pub mod psd;
+
 /// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a per-term kernel.
 ///
 /// [`Problem`] is implemented by the fast evaluator (module `lanes`: four corner lanes per cell,

@@ -192,6 +192,66 @@ impl Region {
         Self::build(outer, holes, true)
     }
 
+    /// Builds a region from rings that the **caller guarantees** to be simple, pairwise
+    /// disjoint (not even touching), with every hole inside the outer ring and no hole inside
+    /// another — rings that are valid *by construction*, e.g. the output of a topology-safe
+    /// simplification of a valid region in which every change was checked with exact
+    /// predicates (`unamalla-contour`). Only the O(n) checks of [`Region::new`] run: finite
+    /// coordinates within [`MIN_COORDINATE`]..=[`MAX_COORDINATE`], no repeated consecutive
+    /// points (an error, as in [`Region::new`]), at least 3 points and non-zero area per ring;
+    /// a closing duplicate is dropped and the orientation is normalised exactly as in
+    /// [`Region::new`] (outer counter-clockwise, holes clockwise, vertex 0 kept first), so for
+    /// valid rings the result **equals** `Region::new(outer, holes)`.
+    ///
+    /// Skipped: the O(n log n) simplicity, disjointness and containment tests (R*-tree over
+    /// all edges). If the guarantee does not hold nothing unsafe happens, but the region is
+    /// invalid and later operations (point location, meshing) give unspecified results: use
+    /// [`Region::new`] for any input that is not valid by construction.
+    ///
+    /// ```
+    /// use unamalla_mesh::{DVec2, Region};
+    /// let sq = vec![DVec2::new(0., 0.), DVec2::new(0., 1.), DVec2::new(1., 1.), DVec2::new(1., 0.)];
+    /// let r = Region::from_simple_rings(sq.clone(), vec![]).unwrap();
+    /// assert_eq!(r, Region::new(sq, vec![]).unwrap()); // clockwise input normalised the same way
+    /// assert!(Region::from_simple_rings(vec![DVec2::ZERO, DVec2::X, DVec2::X], vec![]).is_err());
+    /// ```
+    pub fn from_simple_rings(
+        outer: Vec<DVec2>,
+        holes: Vec<Vec<DVec2>>,
+    ) -> Result<Self, GeometryError> {
+        let mut polys = Vec::with_capacity(holes.len() + 1);
+        let mut outer_source = Vec::new();
+        for (k, ring) in std::iter::once(outer).chain(holes).enumerate() {
+            let id = ring_id(k);
+            let (pts, src, _) = prepare_ring(ring, id, false)?;
+            let (p0, p1) = (pts[0], pts[1]);
+            if pts[2..]
+                .iter()
+                .all(|&p| geometry::orient2d(p0, p1, p) == 0.0)
+            {
+                return Err(GeometryError::ZeroArea { ring: id });
+            }
+            let o = exact_orientation(&pts);
+            let mut poly = Polygon::from_points_unchecked(pts);
+            if k == 0 {
+                outer_source = src;
+                if o < 0.0 {
+                    poly = poly.reversed();
+                    outer_source[1..].reverse();
+                }
+            } else if o > 0.0 {
+                poly = poly.reversed();
+            }
+            polys.push(poly);
+        }
+        let outer = polys.remove(0);
+        Ok(Self {
+            outer,
+            holes: polys,
+            outer_source,
+        })
+    }
+
     fn build(
         outer: Vec<DVec2>,
         holes: Vec<Vec<DVec2>>,

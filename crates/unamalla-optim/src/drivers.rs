@@ -30,8 +30,12 @@ use unamalla_mesh::{FreeNodes, HasHexCells, HasQuadCells};
 
 use crate::error::OptimError;
 use crate::monitor::{Observer, Phase, Session};
-use crate::solver::{minimize_with, QuadLocalGuard, SolveResult, Solver, SolverOptions};
+use crate::psd_model::PsdModel;
+use crate::solver::{
+    minimize_with, HessianMode, QuadLocalGuard, SolveResult, Solver, SolverOptions,
+};
 use crate::status::{Status, StopReason};
+use unamalla_functionals::quad::psd::PsdProjection;
 
 /// The adaptive functional `f₁` and its partner `f₂` (seed 001 Tables 5.1/5.2, §7.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -122,23 +126,45 @@ impl Default for OmegaOptions {
 pub struct CoplanarityOptions {
     /// Fixed `ω` relative to the mean Jacobian (seed 004: `10⁻⁸`).
     pub omega_rel: f64,
-    /// `μ₀` (0.1).
+    /// `μ₀` (default 500, the thesis's Table 4.5 alternative; the thesis's default is 0.1,
+    /// see [`CoplanarityOptions::thesis`]).
     pub mu0: f64,
     /// Stop when `μ ≤ mu_min` (10⁻¹²).
     pub mu_min: f64,
     /// Tolerance on `|cos|` for counting non-planar cells (criterion 2, `ε_n = 10⁻²`).
     pub planarity_tol: f64,
+    /// Planarity stop: end the continuation as soon as every face of every penalized cell has
+    /// max `|cos|` ≤ `stop_cos` (checked every [`check_every`](Self::check_every) solver
+    /// iterations inside a μ step and after each step). `None` = the thesis's schedule, which
+    /// always runs down to `μ_min`.
+    pub stop_cos: Option<f64>,
+    /// Solver iterations between two planarity checks inside a μ step (with `stop_cos`).
+    pub check_every: usize,
     /// Solver options of each minimization.
     pub solver: SolverOptions,
+}
+
+impl CoplanarityOptions {
+    /// The thesis's schedule (seed 004 §4.2, App. B defaults): `μ₀ = 0.1`, `μ ← 0.1μ` while
+    /// `μ > 10⁻¹²`, no planarity stop.
+    pub fn thesis() -> Self {
+        Self {
+            mu0: 0.1,
+            stop_cos: None,
+            ..Self::default()
+        }
+    }
 }
 
 impl Default for CoplanarityOptions {
     fn default() -> Self {
         Self {
             omega_rel: 1e-8,
-            mu0: 0.1,
+            mu0: 500.0,
             mu_min: 1e-12,
             planarity_tol: 1e-2,
+            stop_cos: Some(1e-3),
+            check_every: 5,
             solver: SolverOptions {
                 max_iter: 50,
                 ftol: 1e-8,
@@ -638,6 +664,24 @@ pub fn omega_continuation_hex(
 
 /// Seed 004 §4.2 Algorithm B: from a convex (Algorithm A) mesh, minimize `H_ω + C·Σk²` with
 /// `C = 1/(2μ)` for `μ = μ₀, 0.1μ₀, …` while `μ > μ_min`; the safeguard keeps the mesh convex.
+///
+/// # Default schedule (issue #10; measured in `docs/results.md`, "Algorithm B")
+/// * **μ₀ = 500** (`C₀ = 10⁻³`), the thesis's Table 4.5 alternative, instead of its default
+///   0.1 (`C₀ = 5`). `H_ω` carries the thesis's `1/(10N_c)` normalization (of order 1) while
+///   `Σk²` runs over all `6·N_int` interior faces, so `C₀ = 5` makes the penalty dominate
+///   from the first iteration: on the Pico-like 21³ case the interior cells are pushed
+///   against the convexity safeguard, every μ step stops at its iteration limit with steps
+///   of 1–3 CG iterations, and 12 cells stay non-hexahedral. `C₀ = 10⁻³` lets the harmonic
+///   term shape the mesh while the planarity constraints stiffen gradually; it finished every
+///   built-in case (measured).
+/// * **Planarity stop** (`stop_cos = 10⁻³`, a factor 10 below the counting tolerance
+///   `ε_n = 10⁻²` of criterion 2): the continuation ends as soon as every penalized face
+///   has max `|cos|` ≤ `stop_cos`, checked every `check_every = 5` iterations (see
+///   `coplanarity_step`). The thesis's schedule always runs to `μ = 10⁻¹²`: on the sphere
+///   20³ the faces were already at `|cos| < 10⁻²` after 10 iterations of the first step and
+///   the remaining ≈ 140 iterations (with > 100 CG iterations each, since the forcing sequence
+///   tightens as the gradient falls) only drove `|cos|` from 10⁻⁵ to 10⁻¹².
+/// * The thesis's schedule is [`CoplanarityOptions::thesis`] (CLI: `--b-schedule thesis`).
 pub fn coplanarity_continuation(
     topo: &Arc<HexTopology>,
     scaling: Scaling3,
@@ -666,15 +710,25 @@ pub fn coplanarity_continuation(
     let mut last = None;
     let mut steps = 0;
     let mut p = HexFunctional::h_omega(topo.clone(), omega, scaling)?;
-    while mu > opts.mu_min {
+    let planar = |x: &[f64]| match opts.stop_cos {
+        Some(tol) => topo.planarity_report(x, tol).1 == 0,
+        None => false,
+    };
+    let mut done = planar(x);
+    while mu > opts.mu_min && !done {
         session.monitor.mu = Some(mu);
         p.set_coplanarity(Some(1.0 / (2.0 * mu)))?;
-        let r = minimize_with(&p, x, &opts.solver, session, None)?;
+        let r = if opts.stop_cos.is_some() {
+            coplanarity_step(&p, x, opts, session, &planar, &mut done)?
+        } else {
+            minimize_with(&p, x, &opts.solver, session, None)?
+        };
         steps += 1;
         last = Some(r);
         if r.reason == StopReason::User {
             break;
         }
+        done |= planar(x);
         mu *= 0.1;
     }
     if last.is_none() {
@@ -686,6 +740,56 @@ pub fn coplanarity_continuation(
     rep.mu = session.monitor.mu;
     rep.planarity = Some(topo.planarity_report(x, opts.planarity_tol));
     Ok(rep)
+}
+
+/// One μ step of Algorithm B with the planarity stop: the solver runs in chunks of
+/// `check_every` iterations (at most `solver.max_iter` in all) and the step ends early once
+/// [`HexTopology::planarity_report`] finds every penalized face at `|cos| ≤ stop_cos`
+/// (`done` is then set). GTOL stays relative to the gradient at the start of the step (it
+/// is passed to each chunk as an absolute tolerance); the forcing sequence and the trust
+/// radius restart with each chunk.
+fn coplanarity_step(
+    p: &HexFunctional,
+    x: &mut [f64],
+    opts: &CoplanarityOptions,
+    session: &mut Session<'_>,
+    planar: &dyn Fn(&[f64]) -> bool,
+    done: &mut bool,
+) -> Result<crate::solver::SolveResult, OptimError> {
+    let mut g = vec![0.0; x.len()];
+    p.value_grad(x, &mut g);
+    let g0 = g.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut chunk = SolverOptions {
+        gtol: 0.0,
+        gtol_abs: opts.solver.gtol_abs.max(opts.solver.gtol * g0),
+        ..opts.solver.clone()
+    };
+    let total = opts.solver.max_iter.max(1);
+    let every = opts.check_every.max(1);
+    let mut used = 0;
+    let mut acc: Option<crate::solver::SolveResult> = None;
+    loop {
+        chunk.max_iter = every.min(total - used);
+        let r = minimize_with(p, x, &chunk, session, None)?;
+        used += r.iterations;
+        let merged = match acc {
+            Some(a) => crate::solver::SolveResult {
+                iterations: a.iterations + r.iterations,
+                fevals: a.fevals + r.fevals,
+                cg_iterations: a.cg_iterations + r.cg_iterations,
+                ..r
+            },
+            None => r,
+        };
+        acc = Some(merged);
+        if r.reason != StopReason::MaxIter || used >= total || r.iterations == 0 {
+            return Ok(merged);
+        }
+        if planar(x) {
+            *done = true;
+            return Ok(merged);
+        }
+    }
 }
 
 /// Options of [`block_smoothing`].
@@ -794,7 +898,12 @@ pub fn block_smoothing(
         0.0
     };
     let guard = QuadLocalGuard::new(topo.clone());
-    let r = minimize_with(&p, x, &opts.solver, session, Some(&guard))?;
+    let r = if opts.solver.hessian == HessianMode::ProjectedPsd {
+        let model = PsdModel::new(&p, PsdProjection::Clamp);
+        minimize_with(&model, x, &opts.solver, session, Some(&guard))?
+    } else {
+        minimize_with(&p, x, &opts.solver, session, Some(&guard))?
+    };
     session.guard_threshold = 0.0;
     let mut rep = report(session, &p, x, &init, messages, Some(r), opts.eps);
     rep.omega = Some(omega);

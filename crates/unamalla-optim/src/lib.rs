@@ -88,6 +88,7 @@ pub mod linalg;
 pub mod linesearch;
 pub mod monitor;
 pub mod multigrid;
+pub mod psd_model;
 pub mod solver;
 pub mod status;
 

@@ -89,6 +89,15 @@ pub enum HessianMode {
     /// Matrix-free products through [`Problem::hess_vec`] (no preconditioner is available
     /// then; Jacobi/block-Jacobi still use an assembled diagonal only in `Assembled` mode).
     MatrixFree,
+    /// Assembled like `Assembled`, but the drivers of quad functionals hand the solver a
+    /// [`PsdModel`](crate::psd_model::PsdModel): every corner triangle's leg Hessian projected
+    /// onto the PSD cone before assembly (`unamalla_functionals::quad::psd`), a Gauss–Newton-like
+    /// model whose CG never meets negative curvature. For any other [`Problem`] this is
+    /// `Assembled` (the solver asks the problem for its Hessian). Used by `block_smoothing`
+    /// ((6.8)) only. Measured (docs/benchmarks.md, issue #4): 8–14× slower than the exact
+    /// Hessian on the sinusoidal 100² grid, because `F_AO`'s leg Hessian is indefinite for
+    /// every triangle, so the model differs from the Hessian even at the minimum.
+    ProjectedPsd,
 }
 
 /// Options of one solver run.
@@ -535,7 +544,7 @@ fn truncated_newton<P: Problem + ?Sized>(
 ) -> StopReason {
     let n = x.len();
     let trust = opts.solver == Solver::TnTr;
-    let assembled = opts.hessian == HessianMode::Assembled;
+    let assembled = opts.hessian != HessianMode::MatrixFree;
     if assembled {
         ensure_hessian(problem, session);
     }
