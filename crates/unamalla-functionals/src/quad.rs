@@ -413,6 +413,29 @@ impl QuadTopology {
 
 /// Leg Hessian `H_u = Jᵀ (∂²f/∂s²) J + Σ_s f_s ∇²_u s`, `u = (aₓ, a_y, bₓ, b_y)` (module docs).
 #[inline(always)]
+/// Adds the Hessian `hu` with respect to the legs `u = (a, b)` of the corner triangle with leg
+/// nodes `l` (`a = X_{l₁} − X_{l₀}`, `b = X_{l₃} − X_{l₂}`, cell-local node ids) into the cell's
+/// 8 × 8 node Hessian `h` (chain rule with the ±1 leg Jacobian).
+pub(crate) fn scatter_leg_hessian(h: &mut [[f64; 8]; 8], l: [usize; 4], hu: &[[f64; 4]; 4]) {
+    // (node, sign, leg)
+    let ends = [
+        (l[1], 1.0, 0usize),
+        (l[0], -1.0, 0),
+        (l[3], 1.0, 1),
+        (l[2], -1.0, 1),
+    ];
+    for &(ni, si, li) in &ends {
+        for &(nj, sj, lj) in &ends {
+            let sg = si * sj;
+            for dx in 0..2 {
+                for dy in 0..2 {
+                    h[2 * ni + dx][2 * nj + dy] += sg * hu[2 * li + dx][2 * lj + dy];
+                }
+            }
+        }
+    }
+}
+
 fn leg_hessian(a: DVec2, b: DVec2, d: &Partials) -> [[f64; 4]; 4] {
     // J = ∂s/∂u, u = (ax, ay, bx, by)
     let j = [
@@ -606,24 +629,7 @@ fn cell_hess<K: TriKernel>(
         g[l[0]] -= ga;
         g[l[3]] += gb;
         g[l[2]] -= gb;
-        let hu = leg_hessian(a, b, &d);
-        // (node, sign, leg)
-        let ends = [
-            (l[1], 1.0, 0usize),
-            (l[0], -1.0, 0),
-            (l[3], 1.0, 1),
-            (l[2], -1.0, 1),
-        ];
-        for &(ni, si, li) in &ends {
-            for &(nj, sj, lj) in &ends {
-                let sg = si * sj;
-                for dx in 0..2 {
-                    for dy in 0..2 {
-                        h[2 * ni + dx][2 * nj + dy] += sg * hu[2 * li + dx][2 * lj + dy];
-                    }
-                }
-            }
-        }
+        scatter_leg_hessian(h, LEGS[q], &leg_hessian(a, b, &d));
     }
     v
 }

@@ -31,7 +31,9 @@
 
 use rayon::prelude::*;
 
-use super::{leg_hessian, pair_range, scalars, Plan, QuadFunctional, FIXED, LEGS};
+use super::{
+    leg_hessian, pair_range, scalars, scatter_leg_hessian, Plan, QuadFunctional, FIXED, LEGS,
+};
 use crate::assembly::SyncPtr;
 use crate::csr::Csr;
 use crate::kernels2::{Order, Terms, TriKernel};
@@ -200,24 +202,7 @@ fn psd_assemble<K: TriKernel, KK: TriKernel>(
             if project_psd4(&mut hu, mode) {
                 count += 1.0;
             }
-            let l = LEGS[q];
-            // (node, sign, leg): a = X_{n₁} − X_{n₀}, b = X_{n₃} − X_{n₂}
-            let ends = [
-                (l[1], 1.0, 0usize),
-                (l[0], -1.0, 0),
-                (l[3], 1.0, 1),
-                (l[2], -1.0, 1),
-            ];
-            for &(ni, si, li) in &ends {
-                for &(nj, sj, lj) in &ends {
-                    let sg = si * sj;
-                    for dx in 0..2 {
-                        for dy in 0..2 {
-                            lh[2 * ni + dx][2 * nj + dy] += sg * hu[2 * li + dx][2 * lj + dy];
-                        }
-                    }
-                }
-            }
+            scatter_leg_hessian(&mut lh, LEGS[q], &hu);
         }
         for i in 0..4 {
             let vi = vars[i];
