@@ -1,7 +1,7 @@
 //! Runs every solver with the adaptive-k driver and with Algorithm A on the folded TFI grids
 //! of the seed 001 fixtures and prints the Markdown table of `docs/benchmarks.md`.
 //!
-//! `cargo run --release -p unamalla-optim --example fixtures_table`
+//! `cargo run --release -p unamalla-optim --example seed001_table`
 
 use std::sync::Arc;
 
