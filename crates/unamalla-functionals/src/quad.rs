@@ -402,6 +402,66 @@ impl QuadTopology {
             .as_deref()
     }
 
+    /// Zeroes `h` (a matrix of this topology's Hessian pattern) and adds into it the 8 × 8 cell
+    /// Hessians `cell(c, points) = (H_c, w_c)` of every cell (parallel over the colouring);
+    /// returns `Σ w_c` (a per-cell count the caller wants, e.g. projected triangles). With
+    /// `use_slots` the positions come from the slot tables when they exist; otherwise (and for
+    /// the reference path, which must not share the fast path's tables) from the neighbour
+    /// lists.
+    fn assemble_cell_hessians<F>(&self, x: &[f64], h: &mut Csr, use_slots: bool, cell: F) -> f64
+    where
+        F: Fn(usize, &[DVec2; 4]) -> ([[f64; 8]; 8], f64) + Sync,
+    {
+        let Csr {
+            row_offsets,
+            values,
+            ..
+        } = h;
+        values
+            .par_iter_mut()
+            .with_min_len(4096)
+            .for_each(|v| *v = 0.0);
+        let hp = SyncPtr::new(values);
+        let ro: &[usize] = row_offsets;
+        let slots = if use_slots {
+            self.hessian_slots()
+        } else {
+            None
+        };
+        let asm = &self.asm;
+        asm.run_colored(|c| {
+            let (p, vars) = self.cell_points(x, c);
+            let (lh, w) = cell(c, &p);
+            for i in 0..4 {
+                let vi = vars[i];
+                if vi == FIXED {
+                    continue;
+                }
+                for jn in 0..4 {
+                    let vj = vars[jn];
+                    if vj == FIXED {
+                        continue;
+                    }
+                    let k = match slots {
+                        Some(sl) => (sl[c][4 * i + jn] & !lanes::SLOT_FIRST) as usize,
+                        None => asm.nbr_pos(vi, vj),
+                    };
+                    for dx in 0..2 {
+                        let base = ro[2 * vi as usize + dx] + 2 * k;
+                        // SAFETY: row of a node of this cell (colouring, see `assembly`); `k` is
+                        // the position of `vj` in the neighbour list of `vi`, so both entries lie
+                        // in that row of the pattern (the callers checked the pattern).
+                        unsafe {
+                            hp.add(base, lh[2 * i + dx][2 * jn]);
+                            hp.add(base + 1, lh[2 * i + dx][2 * jn + 1]);
+                        }
+                    }
+                }
+            }
+            w
+        })
+    }
+
     /// Zeroes the entries of free nodes that belong to no cell (the fast paths never write them).
     fn zero_isolated(&self, g: &mut [f64]) {
         for &j in &self.isolated {
@@ -922,45 +982,11 @@ impl<K: TriKernel> QuadFunctional<K> {
     }
 
     fn hessian_generic(&self, x: &[f64], h: &mut Csr) {
-        let Csr {
-            row_offsets,
-            values,
-            ..
-        } = h;
-        values
-            .par_iter_mut()
-            .with_min_len(4096)
-            .for_each(|v| *v = 0.0);
-        let hp = SyncPtr::new(values);
-        let ro: &[usize] = row_offsets;
-        let asm = &self.topo.asm;
-        asm.run_colored(|c| {
-            let (p, vars) = self.topo.cell_points(x, c);
+        self.topo.assemble_cell_hessians(x, h, false, |c, p| {
             let mut lg = [DVec2::ZERO; 4];
             let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, &p, c, None, &mut lg, &mut lh);
-            for i in 0..4 {
-                let vi = vars[i];
-                if vi == FIXED {
-                    continue;
-                }
-                for jn in 0..4 {
-                    let vj = vars[jn];
-                    if vj == FIXED {
-                        continue;
-                    }
-                    let k = asm.nbr_pos(vi, vj);
-                    for dx in 0..2 {
-                        let base = ro[2 * vi as usize + dx] + 2 * k;
-                        // SAFETY: row of a node of this cell; see `assembly` (colouring).
-                        unsafe {
-                            hp.add(base, lh[2 * i + dx][2 * jn]);
-                            hp.add(base + 1, lh[2 * i + dx][2 * jn + 1]);
-                        }
-                    }
-                }
-            }
-            0.0
+            cell_hess(&self.kernel, self.terms, p, c, None, &mut lg, &mut lh);
+            (lh, 0.0)
         });
     }
 

@@ -29,12 +29,7 @@
 //! whose determinant `−3|a|²|b|²` is negative), so the model differs from the exact Hessian
 //! wherever that term has weight.
 
-use rayon::prelude::*;
-
-use super::{
-    leg_hessian, pair_range, scalars, scatter_leg_hessian, Plan, QuadFunctional, FIXED, LEGS,
-};
-use crate::assembly::SyncPtr;
+use super::{leg_hessian, pair_range, scalars, scatter_leg_hessian, Plan, QuadFunctional, LEGS};
 use crate::csr::Csr;
 use crate::kernels2::{Order, Terms, TriKernel};
 
@@ -176,27 +171,12 @@ fn psd_assemble<K: TriKernel, KK: TriKernel>(
     h: &mut Csr,
     mode: PsdProjection,
 ) -> usize {
-    let Csr {
-        row_offsets,
-        values,
-        ..
-    } = h;
-    values
-        .par_iter_mut()
-        .with_min_len(4096)
-        .for_each(|v| *v = 0.0);
-    let hp = SyncPtr::new(values);
-    let ro: &[usize] = row_offsets;
-    let topo = &f.topo;
-    let slots = topo.hessian_slots();
-    let asm = &topo.asm;
     let (lo, hi) = pair_range(terms);
-    let projected = asm.run_colored(|c| {
-        let (p, vars) = topo.cell_points(x, c);
+    let projected = f.topo.assemble_cell_hessians(x, h, true, |c, p| {
         let mut lh = [[0.0; 8]; 8];
         let mut count = 0.0;
         for q in lo..hi {
-            let (a, b, s) = scalars(&p, c, q);
+            let (a, b, s) = scalars(p, c, q);
             let d = kernel.eval(&s, Order::Hessian);
             let mut hu = leg_hessian(a, b, &d);
             if project_psd4(&mut hu, mode) {
@@ -204,33 +184,7 @@ fn psd_assemble<K: TriKernel, KK: TriKernel>(
             }
             scatter_leg_hessian(&mut lh, LEGS[q], &hu);
         }
-        for i in 0..4 {
-            let vi = vars[i];
-            if vi == FIXED {
-                continue;
-            }
-            for jn in 0..4 {
-                let vj = vars[jn];
-                if vj == FIXED {
-                    continue;
-                }
-                let k = match slots {
-                    Some(sl) => (sl[c][4 * i + jn] & !super::lanes::SLOT_FIRST) as usize,
-                    None => asm.nbr_pos(vi, vj),
-                };
-                for dx in 0..2 {
-                    let base = ro[2 * vi as usize + dx] + 2 * k;
-                    // SAFETY: row of a node of this cell (colouring, see `assembly`); `k` is the
-                    // position of `vj` in the neighbour list of `vi`, so the two entries lie in
-                    // that row of the pattern (`check_hessian_args` checked the pattern).
-                    unsafe {
-                        hp.add(base, lh[2 * i + dx][2 * jn]);
-                        hp.add(base + 1, lh[2 * i + dx][2 * jn + 1]);
-                    }
-                }
-            }
-        }
-        count
+        (lh, count)
     });
     projected as usize
 }
