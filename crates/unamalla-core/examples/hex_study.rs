@@ -115,6 +115,9 @@ impl Problem for Variant {
     fn element_measures(&self, x: &[f64], out: &mut [f64]) {
         self.f.element_measures(x, out)
     }
+    fn element_nodes(&self, e: usize, out: &mut Vec<usize>) {
+        self.f.element_nodes(e, out)
+    }
 }
 
 struct AOutcome {

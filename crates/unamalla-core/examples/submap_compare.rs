@@ -7,7 +7,7 @@
 //! ```
 //!
 //! Both strategies get the same region (no contour simplification: the shapes are exact), the same
-//! size (`--cells`, default 2000: `h = √(area/N)`) and the same smoothing (defaults, 20 s budget).
+//! size (`--cells`, default 2000: `h = √(area/N)`) and the same smoothing (defaults, 15 s budget).
 //! With `--fixtures DIR` the shapes are also written as GeoJSON (`DIR/<name>.geojson`).
 
 use unamalla_core::decompose::submap::shapes;

@@ -237,7 +237,7 @@ impl Mesher {
             decomposition: None,
             smooth_opts: default_smooth_options(),
             boundary_density: 1.0,
-            smooth_budget: 20.0,
+            smooth_budget: 15.0,
             feature_factor: DEFAULT_FEATURE_FACTOR,
             flat_corner_deficit: crate::flat_corners::DEFAULT_MIN_DEFICIT_DEG,
             progress: None,
@@ -308,7 +308,7 @@ impl Mesher {
         self.boundary_density = w;
         self
     }
-    /// Wall-time budget of the global smoothing run in seconds (default 20; the local
+    /// Wall-time budget of the global smoothing run in seconds (default 15; the local
     /// untangling before it is bounded by iteration limits instead). Once it is spent and
     /// the mesh is convex (Inocon = 0) the optimizer is stopped and its current iterate — convex,
     /// by the safeguard — is kept; a mesh that is still being untangled gets up to three times

@@ -45,18 +45,31 @@ fn check(result: &MeshResult, holes: usize) {
     // leave its edges unmatched and add boundary edges inside the region)
     let loops = io::msh::boundary_loops(mesh);
     assert_eq!(loops.len(), 1 + holes, "boundary loops");
-    // every boundary node lies on the simplified boundary
+    // every boundary node lies on the simplified boundary, except the flat block corners the
+    // pipeline bends outward on purpose (`report.bent_corners`, by tan 5° of an adjacent
+    // boundary edge at most)
     let (lo, hi) = result.simplified.bounding_box();
     let tol = 1e-9 * (hi - lo).length();
+    let mut off = 0;
     for l in &loops {
         for e in &l.edges {
             let p = mesh.nodes()[e[0]];
-            assert!(
-                distance_to_rings(&result.simplified, p) <= tol,
-                "boundary node {p} off the boundary"
-            );
+            let q = mesh.nodes()[e[1]];
+            let d = distance_to_rings(&result.simplified, p);
+            if d > tol {
+                off += 1;
+                assert!(
+                    d <= 5f64.to_radians().tan() * 2.0 * p.distance(q),
+                    "boundary node {p} is {d} off the boundary"
+                );
+            }
         }
     }
+    assert!(
+        off <= rep.bent_corners,
+        "{off} boundary nodes off the boundary, {} bent corners",
+        rep.bent_corners
+    );
     // the two blocks of every cut share its nodes through their local→global maps (cut nodes
     // move during smoothing, so this is checked topologically: the blocks share at least the
     // cut's two endpoints; the real conformity check is the boundary-loop count above, where an
@@ -119,4 +132,28 @@ fn horse_silhouette_with_a_hole() {
         "{}",
         r.report.mu_ge_0_8_percent
     );
+}
+
+#[test]
+fn gulf_of_mexico_with_its_sliver_island_is_convex_and_smoothed() {
+    // issue #8: the gulf's sliver island (a three-vertex hole ≈ 2° at its tip) and its
+    // global smoothing run, whose optimum has cells at the ε-convexity bound. Before the
+    // spike criterion (decomposition) and the held-back safeguard step (optimizer) this size
+    // ended with the smoothing stuck in a non-convex state (μ ≥ 0.8 on 69.9 % of the cells,
+    // 2026-11-22); it is deterministic here (the global run stops by FTOL well inside its
+    // time budget).
+    let region = load("gulf-of-mexico.geojson");
+    let r = Mesher::new().cells(6_000).mesh(&region).unwrap();
+    check(&r, region.holes().len());
+    assert!(
+        r.report.smoothing.starts_with("Convex grid"),
+        "{}",
+        r.report.smoothing
+    );
+    assert!(
+        r.report.mu_ge_0_8_percent >= 80.0,
+        "{}",
+        r.report.mu_ge_0_8_percent
+    );
+    assert!(r.report.area_change_percent <= 2.0);
 }

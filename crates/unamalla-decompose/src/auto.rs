@@ -548,6 +548,21 @@ impl<'a> Builder<'a> {
                 .then(ring.p(a).y.total_cmp(&ring.p(b).y))
         });
         starts.truncate(self.opts.concave_starts);
+        // spike tips (angle above θ₊) start first whatever their depth: a needle barely
+        // changes κ₃, but it is the reason the piece is not approximately convex
+        let theta_plus = self.opts.tolerances.theta_plus;
+        let mut spikes: Vec<usize> = (0..n)
+            .filter(|&i| ring_angle(&ring.pts, i) > theta_plus)
+            .collect();
+        spikes.sort_by(|&a, &b| {
+            ring_angle(&ring.pts, b)
+                .total_cmp(&ring_angle(&ring.pts, a))
+                .then(ring.p(a).x.total_cmp(&ring.p(b).x))
+                .then(ring.p(a).y.total_cmp(&ring.p(b).y))
+        });
+        starts.retain(|i| !spikes.contains(i));
+        spikes.extend(starts);
+        let starts = spikes;
         let idx = piece.index();
         let w = self.opts.cut_weights;
         for tier in 0..4 {

@@ -16,6 +16,15 @@
 //!
 //! Criteria (4.4)–(4.7): κᵢ(Ω) ≤ τᵢ⁻. Defaults (thesis Obs 4.8): τ₁⁺ = 0.5, τ₁⁻ = 0.1,
 //! τ₂⁻ = 0.45, τ₃⁻ = 0.1. A **critical angle** is an interior angle below θ₋ = 40°.
+//!
+//! **Spike criterion** (beyond the thesis): a piece is approximately convex only if no interior
+//! angle exceeds θ₊ (default 350°). κ₁–κ₄ are area and distance measures, so a needle that
+//! points into the piece — the tip of a sliver island, the end of a one-vertex-wide spit of
+//! the complement — hardly changes them, yet a structured grid cannot pass such a tip inside a
+//! block side: the tip would be a side node shared by two cells of angle α/2 ≈ 179° each (issue
+//! #8, gulf-of-mexico). With the criterion the concavity cut starts at the tip and the cut
+//! along its bisector leaves two angles of α/2 ≤ 180° that are side nodes of two blocks, i.e.
+//! four cells meet at the tip.
 
 use serde::{Deserialize, Serialize};
 use unamalla_mesh::geometry::{convex_hull, point_segment_distance};
@@ -38,6 +47,15 @@ pub struct Tolerances {
     pub tau4_minus: f64,
     /// θ₋ in radians: interior angles below it are critical (default 40°).
     pub theta_minus: f64,
+    /// θ₊ in radians: a piece with an interior angle above it (a needle tip pointing into the
+    /// piece) is not approximately convex (default 350°; beyond the thesis, see the module
+    /// documentation). Files written before this field existed read the default.
+    #[serde(default = "default_theta_plus")]
+    pub theta_plus: f64,
+}
+
+fn default_theta_plus() -> f64 {
+    350f64.to_radians()
 }
 
 impl Default for Tolerances {
@@ -49,6 +67,7 @@ impl Default for Tolerances {
             tau3_minus: 0.1,
             tau4_minus: f64::INFINITY,
             theta_minus: 40f64.to_radians(),
+            theta_plus: default_theta_plus(),
         }
     }
 }
@@ -83,6 +102,8 @@ pub struct Concavity {
     pub point_kappa3: Vec<f64>,
     /// κ₄(p) for every ring vertex (0 on the hull).
     pub point_kappa4: Vec<f64>,
+    /// The largest interior angle of the ring, in radians (compared with θ₊).
+    pub max_angle: f64,
 }
 
 /// Computes κ₁–κ₄, the pockets and the point concavities of a simple counter-clockwise ring
@@ -92,6 +113,11 @@ pub fn concavity(ring: &[DVec2]) -> Concavity {
     let mut hull = convex_hull(ring);
     let mut point_kappa3 = vec![0.0; n];
     let mut point_kappa4 = vec![0.0; n];
+    let max_angle = if n < 3 {
+        0.0
+    } else {
+        (0..n).map(|i| ring_angle(ring, i)).fold(0.0, f64::max)
+    };
     if n < 3 || hull.len() < 3 {
         return Concavity {
             kappa1: 0.0,
@@ -101,6 +127,7 @@ pub fn concavity(ring: &[DVec2]) -> Concavity {
             pockets: Vec::new(),
             point_kappa3,
             point_kappa4,
+            max_angle,
         };
     }
     // hull in ring order: rotate so it starts at its smallest ring index (the hull of a simple
@@ -179,6 +206,7 @@ pub fn concavity(ring: &[DVec2]) -> Concavity {
         pockets,
         point_kappa3,
         point_kappa4,
+        max_angle,
     }
 }
 
@@ -200,10 +228,12 @@ pub fn critical_angles(ring: &[DVec2], theta_minus: f64) -> Vec<usize> {
 }
 
 impl Concavity {
-    /// `true` if every concavity criterion 1–4 holds with the given tolerances (the region is
-    /// "approximately convex").
+    /// `true` if every concavity criterion 1–4 holds with the given tolerances and no interior
+    /// angle exceeds θ₊ (the region is "approximately convex"; the θ₊ spike criterion is beyond
+    /// the thesis, see the module documentation).
     pub fn approximately_convex(&self, tol: &Tolerances) -> bool {
-        self.kappa1 <= tol.tau1_minus
+        self.max_angle <= tol.theta_plus
+            && self.kappa1 <= tol.tau1_minus
             && self.kappa2 <= tol.tau2_minus
             && self.kappa3 <= tol.tau3_minus
             && self.kappa4 <= tol.tau4_minus

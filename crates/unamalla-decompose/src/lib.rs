@@ -88,7 +88,13 @@
 //! be smaller than `min_area_fraction` (2·10⁻⁴) of the region's area (the last tier accepts a
 //! tenth of that, so that a non-convex piece is not left uncut for want of room). Approximate convexity is
 //! criteria 1–4 with the thesis defaults τ₁⁻ = 0.1, τ₂⁻ = 0.45, τ₃⁻ = 0.1 (τ₄⁻ unused)
-//! (module [`concavity`](mod@concavity)). All rankings are geometric; ties are broken by
+//! (module [`concavity`](mod@concavity)) plus, beyond the thesis, the **spike criterion**: no
+//! interior angle above θ₊ = 350° (the tip of a sliver island or of a thin spit of the
+//! exterior changes κ₁–κ₃ too little to be noticed, but a block side cannot pass it: its two
+//! cells there would need angles of ≈ 179° each — issue #8's gulf-of-mexico fold). Such tips
+//! are tried first as starts of the concavity cut, whose bisector candidate leaves two angles
+//! ≤ 180° (tested: `tests/known_answers.rs`, `a_spike_tip_gets_a_cut_so_no_block_keeps_it`).
+//! All rankings are geometric; ties are broken by
 //! coordinates, so the result does not depend on where a ring's numbering starts (tested).
 //!
 //! **Cleanup (merge) pass** (beyond the thesis): greedy splitting can leave cuts that are not

@@ -300,3 +300,118 @@ fn side_curves_cover_the_ring_and_separate_cuts() {
         }
     }
 }
+
+/// Interior (left) angle at `p` of the counter-clockwise chain `a → p → c`, in degrees.
+fn left_angle_deg(a: DVec2, p: DVec2, c: DVec2) -> f64 {
+    let (u, w) = (c - p, a - p);
+    let ang = (u.x * w.y - u.y * w.x).atan2(u.dot(w)).to_degrees();
+    if ang < 0.0 {
+        ang + 360.0
+    } else {
+        ang
+    }
+}
+
+#[test]
+fn a_needle_tip_makes_a_piece_not_approximately_convex() {
+    // a 100 × 40 rectangle with a slit 0.2 wide and 30 deep cut into its top side: a thin spit
+    // of the exterior whose tip (50, 10) has the region's angle 360° − 2·atan(0.1/30) ≈ 359.6°;
+    // κ₁–κ₃ barely notice it
+    let ring = vec![
+        v(0., 0.),
+        v(100., 0.),
+        v(100., 40.),
+        v(50.1, 40.),
+        v(50., 10.),
+        v(49.9, 40.),
+        v(0., 40.),
+    ];
+    let tip = left_angle_deg(ring[3], ring[4], ring[5]);
+    let expected = 360.0 - 2.0 * (0.1f64 / 30.0).atan().to_degrees();
+    assert!((tip - expected).abs() < 1e-9, "{tip} vs {expected}");
+    let tol = Tolerances::default();
+    let c = unamalla_decompose::concavity(&ring);
+    assert!((c.max_angle.to_degrees() - expected).abs() < 1e-9);
+    // the area and distance criteria alone would accept it …
+    let loose = Tolerances {
+        theta_plus: std::f64::consts::TAU,
+        ..tol
+    };
+    assert!(c.kappa2 < 0.01 && c.kappa2 <= tol.tau2_minus);
+    // … the spike criterion (θ₊ = 350° < 359.6°) does not
+    assert!(!c.approximately_convex(&tol));
+    let without_spike = c.kappa1 <= loose.tau1_minus && c.kappa3 <= loose.tau3_minus;
+    assert_eq!(c.approximately_convex(&loose), without_spike);
+}
+
+/// The largest interior angle over all blocks, in degrees.
+fn largest_block_angle(d: &Decomposition) -> f64 {
+    d.blocks
+        .iter()
+        .flat_map(|b| {
+            let n = b.ring.len();
+            (0..n).map(move |i| {
+                left_angle_deg(b.ring[(i + n - 1) % n], b.ring[i], b.ring[(i + 1) % n])
+            })
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_spike_tip_gets_a_cut_so_no_block_keeps_it() {
+    let theta_plus = Tolerances::default().theta_plus.to_degrees();
+    // a 100 × 100 square with a slit 0.2 wide and 6 deep from its top side: the slit's tip
+    // (50, 94) has the region's angle 360° − 2·atan(0.1/6) ≈ 358.1°, while κ₁ ≈ 0.03,
+    // κ₂ ≈ 10⁻⁴ and κ₃ ≈ 6/70.7 ≈ 0.085 all pass their tolerances
+    let tip = v(50., 94.);
+    let r = Region::new(
+        vec![
+            v(0., 0.),
+            v(100., 0.),
+            v(100., 100.),
+            v(50.1, 100.),
+            tip,
+            v(49.9, 100.),
+            v(0., 100.),
+        ],
+        vec![],
+    )
+    .unwrap();
+    // without the spike criterion the square stays one block with the tip inside a side
+    let mut opts = DecomposeOptions::default();
+    opts.tolerances.theta_plus = std::f64::consts::TAU;
+    let d = decompose(&r, &opts).unwrap();
+    assert_eq!(d.blocks.len(), 1);
+    let expected = 360.0 - 2.0 * (0.1f64 / 6.0).atan().to_degrees();
+    assert!((largest_block_angle(&d) - expected).abs() < 1e-9);
+    // with it a cut starts at the tip and leaves two angles ≤ 180° there
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    check_tiling(&r, &d);
+    assert!(
+        largest_block_angle(&d) <= 180.0,
+        "{}",
+        largest_block_angle(&d)
+    );
+    assert!(largest_block_angle(&d) <= theta_plus);
+    let at_tip = d.blocks.iter().filter(|b| b.ring.contains(&tip)).count();
+    assert_eq!(at_tip, 2);
+}
+
+#[test]
+fn a_sliver_island_keeps_no_spike_in_any_block() {
+    // the gulf-of-mexico case (issue #8) in miniature: a sliver island 60 long and 2 wide, tip
+    // angle 2·atan(1/60) ≈ 1.9°, so the region's angle at the tip is ≈ 358.1° > θ₊ = 350°
+    let r = Region::new(
+        vec![v(0., 0.), v(100., 0.), v(100., 100.), v(0., 100.)],
+        vec![vec![v(20., 50.), v(80., 51.), v(80., 49.)]],
+    )
+    .unwrap();
+    let tip = v(20., 50.);
+    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    check_tiling(&r, &d);
+    let theta_plus = Tolerances::default().theta_plus.to_degrees();
+    assert!(largest_block_angle(&d) <= theta_plus);
+    // the tip's 358° are shared by at least two blocks (a cut starts there)
+    let at_tip = d.blocks.iter().filter(|b| b.ring.contains(&tip)).count();
+    assert!(at_tip >= 2, "the tip is a vertex of {at_tip} block(s)");
+}

@@ -1312,6 +1312,9 @@ impl Problem for HexFunctional {
             o.copy_from_slice(&self.tet_dets(&p));
         });
     }
+    fn element_nodes(&self, e: usize, out: &mut Vec<usize>) {
+        out.extend(self.topo.asm.cells[e / 10].iter().map(|&v| v as usize));
+    }
 }
 
 #[cfg(test)]

@@ -60,4 +60,11 @@ pub trait Problem: Send + Sync {
     /// The convexity measures at `x`: α of every corner triangle (2D, `4·cell + corner`) or
     /// the Jacobian determinant of every tetrahedron (3D, `10·cell + tet`).
     fn element_measures(&self, x: &[f64], out: &mut [f64]);
+    /// Appends to `out` the mesh nodes whose positions element `e`'s measure depends on (a
+    /// superset is allowed: the implementations give the nodes of the element's cell). The
+    /// default appends nothing; the solvers' safeguard then cannot tell which nodes block a
+    /// step and shortens the whole step instead of holding those nodes back.
+    fn element_nodes(&self, e: usize, out: &mut Vec<usize>) {
+        let _ = (e, out);
+    }
 }

@@ -44,6 +44,19 @@
 //! check with backtracking of the sweep). Hence a convex start stays convex. Elements whose
 //! vertices are all fixed are boundary data: they are excluded and counted separately.
 //!
+//! When the functional's optimum has cells *at* the threshold (the ε-convex smoothing of a
+//! region with very thin passages), two details matter (issue #8, gulf-of-mexico):
+//! * the trust-region step is cut at the exact first crossing (α is quadratic along a 2D
+//!   step); if that shortens the step, the nodes of the blocking cells are **held back**
+//!   instead ([`Session::hold_back`](monitor::Session::hold_back): their direction components
+//!   are zeroed until no cell would reach the threshold within twice the step) and the
+//!   held-back step is taken when its model decrease is larger — otherwise one cell at the
+//!   threshold shortens every node's step and the whole run stalls;
+//! * an iterate that ends within the margin `10⁻⁹·ᾱ` of the threshold (or, by rounding, a hair
+//!   below it) keeps a guard at `α₋ − 10⁻⁹·ᾱ` ([`Session::guard_active`](monitor::Session::guard_active));
+//!   before, the guard switched off there and the run could fold cells again (the pipeline
+//!   then had to fall back to the start of the run). Test: `tests/guard.rs`.
+//!
 //! ## Stopping and status ([`status`]; seed 001 digest §7.3, Table A.2)
 //! FTOL (relative decrease of F), GTOL (‖g‖ relative to the first gradient, or absolute),
 //! MAXITER, stop by the observer, line-search failures (xtol, rounding, STPMIN, STPMAX, FCN

@@ -246,6 +246,7 @@ pub struct Session<'o> {
     pub guard_threshold: f64,
     /// Whether the safeguard is on.
     pub guard: bool,
+    active_threshold: Option<f64>,
     stop: bool,
     pub(crate) hess: Option<unamalla_functionals::Csr>,
     pub(crate) colors: Option<Vec<Vec<usize>>>,
@@ -293,6 +294,7 @@ impl<'o> Session<'o> {
             meas: a,
             guard_threshold: 0.0,
             guard: true,
+            active_threshold: None,
             stop: false,
             hess: None,
             colors: None,
@@ -359,11 +361,33 @@ impl<'o> Session<'o> {
         m
     }
 
-    /// Whether the safeguard applies at the current iterate whose masked minimum is `cur_min`:
-    /// the guard is on and `cur_min` exceeds the threshold by more than
-    /// [`GUARD_MARGIN`]`·ᾱ` (ᾱ of the last recorded iterate).
-    pub fn guard_active(&self, cur_min: f64) -> bool {
-        self.guard && cur_min > self.guard_threshold + GUARD_MARGIN * self.monitor.alpha_bar.abs()
+    /// Whether the safeguard applies at the current iterate whose masked minimum is `cur_min`,
+    /// and with which threshold (used by [`admissible`](Self::admissible),
+    /// [`max_step`](Self::max_step) and [`hold_back`](Self::hold_back) until the next call):
+    /// the guard is on and `cur_min` exceeds [`guard_threshold`](Self::guard_threshold) by
+    /// more than [`GUARD_MARGIN`]`·ᾱ` (ᾱ of the last recorded iterate) — then that threshold
+    /// applies; otherwise, if the iterate is still convex by more than the margin (it sits at
+    /// the threshold, e.g. after a step that stopped just short of it, or rounding put it a
+    /// hair below), the threshold `cur_min − margin`: the smallest measure then cannot creep
+    /// down by more than the margin per iteration, and a convex iterate never loses its
+    /// convexity; otherwise the guard is off (the iterate is not convex).
+    pub fn guard_active(&mut self, cur_min: f64) -> bool {
+        let margin = GUARD_MARGIN * self.monitor.alpha_bar.abs();
+        self.active_threshold = if !self.guard {
+            None
+        } else if cur_min > self.guard_threshold + margin {
+            Some(self.guard_threshold)
+        } else if cur_min > margin {
+            Some(cur_min - margin)
+        } else {
+            None
+        };
+        self.active_threshold.is_some()
+    }
+
+    /// The threshold the safeguard applies (see [`guard_active`](Self::guard_active)).
+    pub fn threshold(&self) -> f64 {
+        self.active_threshold.unwrap_or(self.guard_threshold)
     }
 
     /// Notifies the observer without counting an iteration (used when a solver run ends
@@ -380,17 +404,34 @@ impl<'o> Session<'o> {
 
     /// `true` if `x_trial` keeps every masked element above the threshold.
     pub fn admissible<P: Problem + ?Sized>(&mut self, problem: &P, x_trial: &[f64]) -> bool {
-        self.masked_min(problem, x_trial) > self.guard_threshold
+        self.masked_min(problem, x_trial) > self.threshold()
     }
 
     /// Fraction-to-boundary step: the largest `t > 0` such that every masked element stays
     /// above the threshold on `[0, t)` along `x + t·d`, computed exactly in 2D (α is quadratic
     /// in `t`: three evaluations at `t = −1, 0, 1`); `+∞` in 3D (where the search bisects).
     pub fn max_step<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64], d: &[f64]) -> f64 {
-        if problem.dim() != 2 {
-            return f64::INFINITY;
-        }
+        let mut times = Vec::new();
+        self.crossing_times(problem, x, d, &mut times);
+        times.into_iter().fold(f64::INFINITY, f64::min)
+    }
+
+    /// Per element, the first `t > 0` at which its measure reaches the threshold along
+    /// `x + t·d` (`+∞` if never, for unmasked elements, for elements already at or below the
+    /// threshold, and for every element in 3D); see [`max_step`](Self::max_step).
+    fn crossing_times<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+        d: &[f64],
+        out: &mut Vec<f64>,
+    ) {
         let ne = self.meas.len();
+        out.clear();
+        out.resize(ne, f64::INFINITY);
+        if problem.dim() != 2 {
+            return;
+        }
         let mut a0 = std::mem::take(&mut self.meas);
         let mut ap = vec![0.0; ne];
         let mut am = vec![0.0; ne];
@@ -401,9 +442,8 @@ impl<'o> Session<'o> {
             .zip(x.iter().zip(d))
             .for_each(|(t, (a, b))| *t = a - b);
         problem.element_measures(&xt, &mut am);
-        let thr = self.guard_threshold;
-        let mut tmax = f64::INFINITY;
-        for i in 0..ne {
+        let thr = self.threshold();
+        for (i, t_out) in out.iter_mut().enumerate() {
             if !self.mask[i] {
                 continue;
             }
@@ -413,7 +453,7 @@ impl<'o> Session<'o> {
             }
             let b = 0.5 * (ap[i] - am[i]);
             let a = 0.5 * (ap[i] + am[i]) - a0[i];
-            let t = if a.abs() <= 1e-14 * (b.abs() + c) {
+            *t_out = if a.abs() <= 1e-14 * (b.abs() + c) {
                 if b < 0.0 {
                     -c / b
                 } else {
@@ -435,10 +475,60 @@ impl<'o> Session<'o> {
                     r
                 }
             };
-            tmax = tmax.min(t);
         }
         self.meas = a0;
-        tmax
+    }
+
+    /// Holds back the nodes that block the step `d` from `x`: the direction components of
+    /// every free node of an element that would reach the threshold before `t = reach` are
+    /// set to zero and marked in `held` (one flag per variable, not cleared here), repeated
+    /// (at most four rounds) until no element blocks or nothing more can be held back.
+    /// Returns the fraction-to-boundary step of the resulting `d`
+    /// ([`max_step`](Self::max_step)).
+    ///
+    /// Shortening the whole step instead (the plain fraction-to-the-boundary rule) stalls
+    /// every node as soon as one cell sits at the safeguard's threshold — the situation of a
+    /// smoothing run whose optimum has a few cells at the ε-convexity bound. Holding back
+    /// only the blocking cells' nodes lets the rest of the mesh converge (the solvers then
+    /// solve for a step of the other nodes: an active-set step). Needs
+    /// [`Problem::element_nodes`]; without it `d` is unchanged.
+    pub fn hold_back<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+        d: &mut [f64],
+        held: &mut [bool],
+        reach: f64,
+    ) -> f64 {
+        let dim = problem.dim();
+        let mut times = Vec::new();
+        let mut nodes = Vec::new();
+        for _ in 0..4 {
+            self.crossing_times(problem, x, d, &mut times);
+            let mut moved = 0usize;
+            for (e, &t) in times.iter().enumerate() {
+                if t >= reach {
+                    continue;
+                }
+                nodes.clear();
+                problem.element_nodes(e, &mut nodes);
+                for &v in &nodes {
+                    if let Some(j) = problem.var_of(v) {
+                        for k in dim * j..dim * (j + 1) {
+                            held[k] = true;
+                            if d[k] != 0.0 {
+                                d[k] = 0.0;
+                                moved += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            if moved == 0 {
+                return times.into_iter().fold(f64::INFINITY, f64::min);
+            }
+        }
+        self.max_step(problem, x, d)
     }
 
     /// Sets the phase of the following iterations.

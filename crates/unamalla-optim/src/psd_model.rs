@@ -69,6 +69,9 @@ impl<K: TriKernel> Problem for PsdModel<'_, K> {
     fn element_measures(&self, x: &[f64], out: &mut [f64]) {
         self.f.element_measures(x, out)
     }
+    fn element_nodes(&self, e: usize, out: &mut Vec<usize>) {
+        self.f.element_nodes(e, out)
+    }
 }
 
 #[cfg(test)]

@@ -417,6 +417,11 @@ impl State {
     }
 }
 
+/// Elements that would reach the safeguard's threshold before this multiple of a full step
+/// hold their nodes back ([`Session::hold_back`]): after a full step each remaining element
+/// keeps about half of its distance to the threshold.
+const HOLD_BACK_REACH: f64 = 2.0;
+
 struct CgWork {
     r: Vec<f64>,
     y: Vec<f64>,
@@ -571,6 +576,10 @@ fn truncated_newton<P: Problem + ?Sized>(
         hz: vec![0.0; n],
         z: vec![0.0; n],
     };
+    // work space of the held-back step (see `Session::hold_back`)
+    let m = if trust { n } else { 0 };
+    let mut held = vec![false; m];
+    let mut z2 = vec![0.0; m];
     let mut xt = vec![0.0; n];
     let mut gt = vec![0.0; n];
     let mut radius = f64::INFINITY;
@@ -617,7 +626,34 @@ fn truncated_newton<P: Problem + ?Sized>(
                 }
                 if guard {
                     // fraction to the boundary of the admissible set
-                    let tm = session.max_step(problem, xr, &w.z);
+                    let mut tm = session.max_step(problem, xr, &w.z);
+                    if tm < 1.0 {
+                        // hold back the nodes of the blocking cells instead (so that one cell
+                        // at the threshold does not stall the whole mesh, nor creep towards
+                        // the threshold step by step); the shortened full step only when the
+                        // held-back step does not decrease the model
+                        held.iter_mut().for_each(|h| *h = false);
+                        z2.copy_from_slice(&w.z);
+                        let tm2 =
+                            session.hold_back(problem, xr, &mut z2, &mut held, HOLD_BACK_REACH);
+                        if tm2 > tm {
+                            hv(&z2, &mut w.hd);
+                            let (gz2, zhz2) = (dot(g, &z2), dot(&z2, &w.hd));
+                            let tau2 = if tm2 < 1.0 { 0.9 * tm2 } else { 1.0 };
+                            let tau = if tm < 1.0 { 0.9 * tm } else { 1.0 };
+                            let pred2 = -(tau2 * gz2 + 0.5 * tau2 * tau2 * zhz2);
+                            let pred1 = -(tau * o.gz + 0.5 * tau * tau * o.zhz);
+                            if pred2 > pred1 && pred2 > 0.0 {
+                                let ratio = norm(&z2) / norm(&w.z).max(f64::MIN_POSITIVE);
+                                w.z.copy_from_slice(&z2);
+                                o.gz = gz2;
+                                o.zhz = zhz2;
+                                o.pred = -(gz2 + 0.5 * zhz2);
+                                o.znorm_m *= ratio;
+                                tm = tm2;
+                            }
+                        }
+                    }
                     if tm < 1.0 {
                         let tau = 0.9 * tm;
                         w.z.iter_mut().for_each(|v| *v *= tau);
@@ -945,9 +981,9 @@ fn pointwise<P: Problem + ?Sized>(
         t: f64,
         done: bool,
     }
-    let thr = session.guard_threshold;
     let reason = loop {
         let guard = session.guard_active(st.cur_min);
+        let thr = session.threshold();
         x0.copy_from_slice(x);
         for class in &colors {
             for &comp in &comps {
