@@ -538,8 +538,9 @@ impl<'a> Builder<'a> {
         let conc = concavity(&ring.pts);
         let area = piece.area();
         let sq = area.sqrt();
+        let angle: Vec<f64> = (0..n).map(|i| ring_angle(&ring.pts, i)).collect();
         let mut starts: Vec<usize> = (0..n)
-            .filter(|&i| ring_angle(&ring.pts, i) > PI && conc.point_kappa3[i] > 0.0)
+            .filter(|&i| angle[i] > PI && conc.point_kappa3[i] > 0.0)
             .collect();
         starts.sort_by(|&a, &b| {
             conc.point_kappa3[b]
@@ -551,12 +552,10 @@ impl<'a> Builder<'a> {
         // spike tips (angle above θ₊) start first whatever their depth: a needle barely
         // changes κ₃, but it is the reason the piece is not approximately convex
         let theta_plus = self.opts.tolerances.theta_plus;
-        let mut spikes: Vec<usize> = (0..n)
-            .filter(|&i| ring_angle(&ring.pts, i) > theta_plus)
-            .collect();
+        let mut spikes: Vec<usize> = (0..n).filter(|&i| angle[i] > theta_plus).collect();
         spikes.sort_by(|&a, &b| {
-            ring_angle(&ring.pts, b)
-                .total_cmp(&ring_angle(&ring.pts, a))
+            angle[b]
+                .total_cmp(&angle[a])
                 .then(ring.p(a).x.total_cmp(&ring.p(b).x))
                 .then(ring.p(a).y.total_cmp(&ring.p(b).y))
         });

@@ -9,6 +9,12 @@
 
 use rayon::prelude::*;
 
+/// Sets every entry of `v` to zero, in parallel (the start of every scatter-add assembly of
+/// a gradient or of Hessian values).
+pub(crate) fn par_zero(v: &mut [f64]) {
+    v.par_iter_mut().with_min_len(4096).for_each(|v| *v = 0.0);
+}
+
 /// A sparse matrix in compressed-sparse-row form with **both** triangles stored (the Hessians
 /// are symmetric; storing both makes products and row access trivial).
 ///

@@ -1040,10 +1040,7 @@ impl HexFunctional {
             values,
             ..
         } = h;
-        values
-            .par_iter_mut()
-            .with_min_len(4096)
-            .for_each(|v| *v = 0.0);
+        crate::csr::par_zero(values);
         let hp = SyncPtr::new(values);
         let ro: &[usize] = row_offsets;
         let asm = &self.topo.asm;
@@ -1135,7 +1132,7 @@ impl Problem for HexFunctional {
             self.num_vars(),
             "value_grad: g has the wrong length"
         );
-        g.par_iter_mut().with_min_len(4096).for_each(|v| *v = 0.0);
+        crate::csr::par_zero(g);
         let gp = SyncPtr::new(g);
         self.topo.asm.run_colored(|c| {
             let (p, vars) = self.topo.cell_points(x, c);
@@ -1182,10 +1179,7 @@ impl Problem for HexFunctional {
             return;
         };
         let values = &mut h.values;
-        values
-            .par_iter_mut()
-            .with_min_len(4096)
-            .for_each(|v| *v = 0.0);
+        crate::csr::par_zero(values);
         let hp = SyncPtr::new(values);
         let topo = &*self.topo;
         topo.asm.run_colored(|c| {

@@ -417,10 +417,7 @@ impl QuadTopology {
             values,
             ..
         } = h;
-        values
-            .par_iter_mut()
-            .with_min_len(4096)
-            .for_each(|v| *v = 0.0);
+        crate::csr::par_zero(values);
         let hp = SyncPtr::new(values);
         let ro: &[usize] = row_offsets;
         let slots = if use_slots {
@@ -933,7 +930,7 @@ impl<K: TriKernel> QuadFunctional<K> {
             self.topo.num_vars(),
             "value_grad: g has the wrong length"
         );
-        g.par_iter_mut().with_min_len(4096).for_each(|v| *v = 0.0);
+        crate::csr::par_zero(g);
         let gp = SyncPtr::new(g);
         self.topo.asm.run_colored(|c| {
             let (p, vars) = self.topo.cell_points(x, c);

@@ -481,23 +481,20 @@ impl<'o> Session<'o> {
 
     /// Holds back the nodes that block the step `d` from `x`: the direction components of
     /// every free node of an element that would reach the threshold before `t = reach` are
-    /// set to zero and marked in `held` (one flag per variable, not cleared here), repeated
-    /// (at most four rounds) until no element blocks or nothing more can be held back.
-    /// Returns the fraction-to-boundary step of the resulting `d`
+    /// set to zero, repeated (at most four rounds) until no element blocks or nothing more can
+    /// be held back. Returns the fraction-to-boundary step of the resulting `d`
     /// ([`max_step`](Self::max_step)).
     ///
     /// Shortening the whole step instead (the plain fraction-to-the-boundary rule) stalls
     /// every node as soon as one cell sits at the safeguard's threshold — the situation of a
     /// smoothing run whose optimum has a few cells at the ε-convexity bound. Holding back
-    /// only the blocking cells' nodes lets the rest of the mesh converge (the solvers then
-    /// solve for a step of the other nodes: an active-set step). Needs
+    /// only the blocking cells' nodes lets the rest of the mesh converge. Needs
     /// [`Problem::element_nodes`]; without it `d` is unchanged.
     pub fn hold_back<P: Problem + ?Sized>(
         &mut self,
         problem: &P,
         x: &[f64],
         d: &mut [f64],
-        held: &mut [bool],
         reach: f64,
     ) -> f64 {
         let dim = problem.dim();
@@ -514,10 +511,9 @@ impl<'o> Session<'o> {
                 problem.element_nodes(e, &mut nodes);
                 for &v in &nodes {
                     if let Some(j) = problem.var_of(v) {
-                        for k in dim * j..dim * (j + 1) {
-                            held[k] = true;
-                            if d[k] != 0.0 {
-                                d[k] = 0.0;
+                        for c in &mut d[dim * j..dim * (j + 1)] {
+                            if *c != 0.0 {
+                                *c = 0.0;
                                 moved += 1;
                             }
                         }

@@ -576,10 +576,8 @@ fn truncated_newton<P: Problem + ?Sized>(
         hz: vec![0.0; n],
         z: vec![0.0; n],
     };
-    // work space of the held-back step (see `Session::hold_back`)
-    let m = if trust { n } else { 0 };
-    let mut held = vec![false; m];
-    let mut z2 = vec![0.0; m];
+    // the held-back step (see `Session::hold_back`; trust region only)
+    let mut z2 = vec![0.0; if trust { n } else { 0 }];
     let mut xt = vec![0.0; n];
     let mut gt = vec![0.0; n];
     let mut radius = f64::INFINITY;
@@ -632,15 +630,13 @@ fn truncated_newton<P: Problem + ?Sized>(
                         // at the threshold does not stall the whole mesh, nor creep towards
                         // the threshold step by step); the shortened full step only when the
                         // held-back step does not decrease the model
-                        held.iter_mut().for_each(|h| *h = false);
                         z2.copy_from_slice(&w.z);
-                        let tm2 =
-                            session.hold_back(problem, xr, &mut z2, &mut held, HOLD_BACK_REACH);
+                        let tm2 = session.hold_back(problem, xr, &mut z2, HOLD_BACK_REACH);
                         if tm2 > tm {
                             hv(&z2, &mut w.hd);
                             let (gz2, zhz2) = (dot(g, &z2), dot(&z2, &w.hd));
                             let tau2 = if tm2 < 1.0 { 0.9 * tm2 } else { 1.0 };
-                            let tau = if tm < 1.0 { 0.9 * tm } else { 1.0 };
+                            let tau = 0.9 * tm;
                             let pred2 = -(tau2 * gz2 + 0.5 * tau2 * tau2 * zhz2);
                             let pred1 = -(tau * o.gz + 0.5 * tau * tau * o.zhz);
                             if pred2 > pred1 && pred2 > 0.0 {
