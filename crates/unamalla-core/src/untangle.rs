@@ -218,7 +218,15 @@ where
     let mut patch = QuadMesh::new(pts, quads)?;
     patch.set_fixed(fixed)?;
     let mut never_stop = |_: &Monitor| Control::Continue;
-    let res = smooth(&mut patch, opts, &mut never_stop)?;
+    let res = match smooth(&mut patch, opts, &mut never_stop) {
+        Ok(res) => res,
+        // a patch folded so badly that its cells have a negative total area has no mean α to
+        // scale the functional by: leave it to a larger patch or to the global run
+        Err(OptimError::InvalidOption {
+            name: "mean alpha", ..
+        }) => return Ok(None),
+        Err(e) => return Err(e),
+    };
     let after = non_convex_cells(&patch).len();
     let moved = nodes
         .iter()
@@ -286,6 +294,24 @@ mod tests {
         // spots — belongs to no patch and must not move
         assert!(r.max_radius <= 8, "{r:?}");
         assert_eq!(mesh.nodes()[at(19, 1)], start[at(19, 1)]);
+    }
+
+    /// A patch whose fixed nodes enclose a negative area (here the whole mesh is a mirrored
+    /// grid: every cell is clockwise) has no mean α to scale the functional by; it is skipped,
+    /// not an error that would stop the pipeline (gulf-of-mexico once failed this way), and
+    /// nothing moves.
+    #[test]
+    fn a_patch_enclosing_negative_area_is_skipped() {
+        let g =
+            StructuredGrid2::from_fn(5, 5, |i, j| DVec2::new(-(i as f64), j as f64)).expect("grid");
+        let mut mesh = QuadMesh::from_grid(&g);
+        let start = mesh.nodes().to_vec();
+        let before = non_convex_cells(&mesh).len();
+        assert_eq!(before, 16, "every mirrored cell is clockwise");
+        let r = untangle_patches(&mut mesh, &SmoothOptions::default(), &DEFAULT_PATCH_RADII)
+            .expect("a negative-area patch is skipped, not an error");
+        assert_eq!((r.before, r.after, r.patches), (16, 16, 0));
+        assert_eq!(mesh.nodes(), &start[..]);
     }
 
     /// Nothing folded: nothing moves and no patch is solved.

@@ -109,12 +109,16 @@
 //! **Corner repair** (beyond the thesis, module `repair`): after the merge pass, a block with
 //! fewer than four *usable* corners (interior angle < 170°), a critical angle or a non-convex
 //! shape is split by one more cut into two good blocks, or merged with a neighbour (and the
-//! union re-split), so that the shared cut meets the boundary at a better angle. Note the
+//! union re-split), so that the shared cut meets the boundary at a better angle; failing that,
+//! the block alone or with one neighbour is re-split by **two** cuts into three good blocks, or
+//! its union with two neighbours into two or three (a good neighbour's corner score may get at
+//! most 0.05 worse). With this step every block of every bundled region is admissible at the
+//! mesher's defaults (`tests/fixtures.rs`, `pipeline_regions_meet_the_corner_rules`). Note the
 //! counting bound behind it: a straight cut adds at most two usable corners at each end, and one
 //! block, so a region (or a union of blocks) with fewer than four usable vertices can never be
 //! cut into blocks with four usable corners each — a triangle stays a triangle block.
 //!
-//! **No corner inside a cut** (issue #6, third step of the repair): a block that would still
+//! **No corner inside a cut** (issue #6, fourth step of the repair): a block that would still
 //! need a point inside a cut for the triangle-block rule (bounded by cuts where its corners
 //! must go, fewer than four usable vertices) is split or merged and re-split with a relaxed
 //! acceptance (a critical angle or a non-convex block is accepted, a cut joint is not).

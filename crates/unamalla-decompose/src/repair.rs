@@ -19,6 +19,19 @@
 //!    endpoints) when the union is good, or **a merge followed by a split** of the union into two
 //!    good blocks (this moves the shared cut so that it meets the boundary at a better angle).
 //!
+//! 3. **a re-split by two cuts** (issue #6, for the critical angles that relaxed-tier cuts
+//!    leave where they meet a channel's far shore or another cut): the block alone or its union
+//!    with one neighbour is split into **three** good blocks — a first cut leaves one good
+//!    child, the best second cut splits the other into two (`Builder::best_split3`) — or, only
+//!    when neither works, its union with two neighbours (a neighbour of the block and one of
+//!    the block or of that neighbour) into two or three good blocks. A good neighbour may not
+//!    come out with a corner score more than `RESPLIT_SLACK` = 0.05 worse than the worst good
+//!    block of the union (without this bound a small block's repair re-cornered the Gulf of
+//!    Mexico's 39-vertex central basin and its transfinite grid folded). The blocks of the
+//!    union are replaced in place, so a repair changes the neighbours of blocks already passed
+//!    over: the pass sweeps again while the last sweep changed something (bounded by a budget
+//!    of 4 × blocks + 16 attempts).
+//!
 //! Candidates are scored like the concavity cuts of the crate documentation:
 //! `S = ½·max(F₁, F₂) + ¼·(F₁ + F₂) + w_a·ḡ + w_l·ℓ/√A` with F the corner score of a child (a
 //! merged block alone scores `F(U)`); the lowest S wins, ties broken by coordinates. User cuts from
@@ -26,12 +39,12 @@
 //! a triangle cannot be split into quadrilaterals by straight cuts without an interior node of
 //! valence 3) get the triangle-block rule of seed 000 digest §4.2 afterwards.
 //!
-//! 3. **No corner inside a cut** (issue #6, `Builder::joint_pass`): a block that is bounded by
+//! 4. **No corner inside a cut** (issue #6, `Builder::joint_pass`): a block that is bounded by
 //!    cuts on the sides where it would need corners and has fewer than four usable vertices
 //!    (maryland's "block 4" at the pipeline defaults: a quadrilateral of four cuts with a
 //!    reflex vertex and a 30° vertex) could only get the triangle-block rule by inserting points
 //!    **inside cuts** — each such point is a cut joint, an interior mesh node where one grid
-//!    has a corner and the neighbour a straight side (valence 3 and 5). When steps 1–2 find no
+//!    has a corner and the neighbour a straight side (valence 3 and 5). When steps 1–3 find no
 //!    repair into good blocks, the block is split, or merged with a neighbour (and the union
 //!    re-split), by the same candidates with a relaxed acceptance: every resulting block must
 //!    take its corners without a point inside a cut, and costs `grade + F` with grade 0 for a
@@ -50,6 +63,10 @@ use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
 const TMP_CUT: usize = usize::MAX - 7;
+
+/// Placeholder id of the *first* cut of a three-way split while its second cut (tagged
+/// [`TMP_CUT`]) is evaluated.
+const TMP_CUT2: usize = usize::MAX - 8;
 
 /// The union of rings `a` and `b` across their shared cut edge (`a.tags[ea]` and `b.tags[eb]`
 /// are the same cut, in opposite directions); `None` if the result would be degenerate.
@@ -76,12 +93,52 @@ pub(crate) fn union_ring(a: &Ring, ea: usize, b: &Ring, eb: usize) -> Option<Rin
     (pts.len() >= 3 && tags.len() == pts.len()).then_some(Ring { pts, tags })
 }
 
+/// `r` with every edge tagged cut `from` re-tagged cut `to`.
+fn retag(mut r: Ring, from: usize, to: usize) -> Ring {
+    for t in &mut r.tags {
+        if *t == Tag::Cut(from) {
+            *t = Tag::Cut(to);
+        }
+    }
+    r
+}
+
 /// A split candidate: score, the two children (new cut tagged [`TMP_CUT`]), cut endpoints.
 type Split = (f64, Ring, Ring, (DVec2, DVec2));
 
 /// A merge candidate: score, neighbour slot, shared cut, split of the union (`None`: the union
 /// is kept whole), union.
 type Merge = (f64, usize, usize, Option<Split>, Ring);
+
+/// A re-split of a block or of a union of blocks (step 3 of the repair): score, the two or
+/// three children, and the endpoints of the one or two new cuts (cut `i` tagged `TMP_IDS[i]`
+/// in the children).
+type Resplit = (f64, Vec<Ring>, Vec<(DVec2, DVec2)>);
+
+/// How much worse (corner score F, module [`corners`](crate::corners)) than the worst good
+/// block it replaces a block produced by a re-split (step 3) may be.
+const RESPLIT_SLACK: f64 = 0.05;
+
+/// The placeholder tags of the first and second cut of a [`Resplit`].
+const TMP_IDS: [usize; 2] = [TMP_CUT2, TMP_CUT];
+
+/// Where a re-split applies: the block alone, its union with the neighbour in slot
+/// `j` across cut `c`, or its union with two neighbours (`j` across `c`, then `j2` across `c2`,
+/// a neighbour of the block or of `j`).
+#[derive(Clone, Copy)]
+enum Host {
+    Alone,
+    Merged {
+        j: usize,
+        c: usize,
+    },
+    Merged2 {
+        j: usize,
+        c: usize,
+        j2: usize,
+        c2: usize,
+    },
+}
 
 impl Builder<'_> {
     /// Four usable corners (see the module documentation).
@@ -93,10 +150,11 @@ impl Builder<'_> {
     /// approximately convex, no critical angle, not negligible.
     fn good(&self, ring: &Ring) -> bool {
         let tol = &self.opts.tolerances;
+        // cheapest tests first: the corner search is O(n⁴) in the ring's vertex count
         crate::geom::signed_area(&ring.pts) >= 0.1 * self.min_area
-            && self.usable(&ring.pts)
             && critical_angles(&ring.pts, tol.theta_minus).is_empty()
             && concavity(&ring.pts).approximately_convex(tol)
+            && self.usable(&ring.pts)
     }
 
     /// `true` if block `ring` should be repaired: four or more vertices and fewer than four
@@ -148,13 +206,37 @@ impl Builder<'_> {
         accept: &dyn Fn(&Ring) -> Option<f64>,
         quarter_points: bool,
     ) -> Option<Split> {
+        let mut best: Option<Split> = None;
+        self.for_each_split(ring, quarter_points, &mut |pre, a, b, ends| {
+            let (Some(fa), Some(fb)) = (accept(&a), accept(&b)) else {
+                return;
+            };
+            let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
+            if best.as_ref().is_none_or(|b| s < b.0) {
+                best = Some((s, a, b, ends));
+            }
+        });
+        best
+    }
+
+    /// Calls `visit(pre, a, b, ends)` for the first 80 admissible cuts of `ring` in the order
+    /// of their cheap terms `pre = w_a·ḡ + w_l·ℓ/√A` (ties broken by coordinates): `a`, `b` are
+    /// the children (the new cut tagged [`TMP_CUT`]) and `ends` the cut's endpoints. Targets:
+    /// vertex → vertex and vertex → foot of the perpendicular on an original-boundary edge,
+    /// with `quarter_points` also the quarter points of those edges.
+    fn for_each_split(
+        &self,
+        ring: &Ring,
+        quarter_points: bool,
+        visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
+    ) {
         let piece = Piece {
             outer: ring.clone(),
             holes: Vec::new(),
         };
         let n = ring.len();
         if n < 4 {
-            return None;
+            return;
         }
         let idx = piece.index();
         let sq = piece.area().abs().sqrt().max(1e-300);
@@ -208,7 +290,6 @@ impl Builder<'_> {
                     .then(qa.y.total_cmp(&qb.y))
             })
         });
-        let mut best: Option<Split> = None;
         let mut evaluated = 0;
         for (pre, e1, e2) in cands {
             if evaluated >= 80 {
@@ -221,13 +302,42 @@ impl Builder<'_> {
             let mut m = piece.clone();
             let (x, y) = m.insert_ends(e1, e2);
             let (a, b) = m.split(x, y, TMP_CUT);
-            let (Some(fa), Some(fb)) = (accept(&a.outer), accept(&b.outer)) else {
-                continue;
-            };
-            let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
-            if best.as_ref().is_none_or(|b| s < b.0) {
-                best = Some((s, a.outer, b.outer, (m.outer.p(x), m.outer.p(y))));
+            visit(pre, a.outer, b.outer, (m.outer.p(x), m.outer.p(y)));
+        }
+    }
+
+    /// The best split of `ring` by **two** cuts into three blocks that `accept` takes (step 3
+    /// of the repair): a first cut leaves one accepted child and one that the best second cut
+    /// ([`Builder::best_split_by`]) splits into two accepted children. Only first cuts that do
+    /// not already give two accepted children are followed (those are steps 1–2). Score
+    /// `½·max(F₁, F₂, F₃) + (F₁ + F₂ + F₃)/6 + pre₁ + pre₂` — the two-child score
+    /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
+    fn best_split3(&self, ring: &Ring, accept: &dyn Fn(&Ring) -> Option<f64>) -> Option<Resplit> {
+        let first = |r: Ring| retag(r, TMP_CUT, TMP_CUT2);
+        let mut best: Option<Resplit> = None;
+        for quarter_points in [false, true] {
+            if quarter_points && (best.is_some() || !self.opts.edge_point_cuts) {
+                break;
             }
+            self.for_each_split(ring, quarter_points, &mut |pre1, a, b, ends1| {
+                let (fa, fb) = (accept(&a), accept(&b));
+                let (kept, fk, rest) = match (fa, fb) {
+                    (Some(fa), None) => (a, fa, b),
+                    (None, Some(fb)) => (b, fb, a),
+                    _ => return,
+                };
+                let Some((s2, r1, r2, ends2)) = self.best_split_by(&first(rest), accept) else {
+                    return;
+                };
+                let (Some(f1), Some(f2)) = (accept(&r1), accept(&r2)) else {
+                    return;
+                };
+                let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
+                let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
+                if best.as_ref().is_none_or(|b| s < b.0) {
+                    best = Some((s, vec![first(kept), r1, r2], vec![ends1, ends2]));
+                }
+            });
         }
         best
     }
@@ -235,15 +345,25 @@ impl Builder<'_> {
     /// Commits a split: a real cut id replaces [`TMP_CUT`].
     fn commit_split(&mut self, a: Ring, b: Ring, ends: (DVec2, DVec2)) -> (Ring, Ring, usize) {
         let id = self.new_cut(ends.0, ends.1);
-        let fix = |mut r: Ring| {
-            for t in &mut r.tags {
-                if *t == Tag::Cut(TMP_CUT) {
-                    *t = Tag::Cut(id);
-                }
-            }
-            r
-        };
-        (fix(a), fix(b), id)
+        (retag(a, TMP_CUT, id), retag(b, TMP_CUT, id), id)
+    }
+
+    /// Commits a [`Resplit`]'s cuts: real cut ids replace the placeholder tags.
+    fn commit_resplit(
+        &mut self,
+        children: Vec<Ring>,
+        ends: &[(DVec2, DVec2)],
+    ) -> (Vec<Ring>, Vec<usize>) {
+        let ids: Vec<usize> = ends.iter().map(|e| self.new_cut(e.0, e.1)).collect();
+        let children = children
+            .into_iter()
+            .map(|r| {
+                ids.iter()
+                    .zip(TMP_IDS)
+                    .fold(r, |r, (&id, tmp)| retag(r, tmp, id))
+            })
+            .collect();
+        (children, ids)
     }
 
     /// Records a repair split of block slot `k` into slots `k` and `m` in the tree: the first
@@ -292,8 +412,42 @@ impl Builder<'_> {
         alive: &[bool],
         accept: &dyn Fn(&Ring) -> Option<f64>,
     ) -> Option<Merge> {
-        let r = slot[k].as_ref()?;
         let mut best: Option<Merge> = None;
+        for (j, c, u) in self.neighbour_unions(slot, k, alive) {
+            let option = match accept(&u) {
+                Some(cost) => Some((cost, None)),
+                None => self.best_split_by(&u, accept).map(|s| (s.0, Some(s))),
+            };
+            if let Some((s, split)) = option {
+                let key = u.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
+                let better = best.as_ref().is_none_or(|b| {
+                    s < b.0 - 1e-12
+                        || ((s - b.0).abs() <= 1e-12 && {
+                            let kb = b.4.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
+                            (key.x, key.y) < (kb.x, kb.y)
+                        })
+                });
+                if better {
+                    best = Some((s, j, c, split, u));
+                }
+            }
+        }
+        best
+    }
+
+    /// The unions of block slot `k` with each neighbour across one live, unprotected cut
+    /// (the two blocks share exactly that cut's endpoints), as (neighbour slot, cut, union);
+    /// degenerate or clockwise unions are left out.
+    fn neighbour_unions(
+        &self,
+        slot: &[Option<Ring>],
+        k: usize,
+        alive: &[bool],
+    ) -> Vec<(usize, usize, Ring)> {
+        let Some(r) = slot[k].as_ref() else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
         for (e, t) in r.tags.iter().enumerate() {
             let Tag::Cut(c) = *t else { continue };
             if c < self.protected_cuts || !alive.get(c).copied().unwrap_or(false) {
@@ -320,28 +474,138 @@ impl Builder<'_> {
             let Some(u) = union_ring(r, e, other, f) else {
                 continue;
             };
-            if crate::geom::signed_area(&u.pts) <= 0.0 {
-                continue;
+            if crate::geom::signed_area(&u.pts) > 0.0 {
+                out.push((j, c, u));
             }
-            let option = match accept(&u) {
-                Some(cost) => Some((cost, None)),
-                None => self.best_split_by(&u, accept).map(|s| (s.0, Some(s))),
+        }
+        out
+    }
+
+    /// Step 3 of the repair: the best re-split into good blocks of block slot `k` alone, of
+    /// its union with one neighbour (both by two cuts into three blocks,
+    /// [`Builder::best_split3`]), or of its union with two neighbours (by two cuts into three
+    /// blocks, or by one cut into two). The lowest score wins, ties broken by the coordinates
+    /// of the first child's vertices.
+    fn best_resplit(
+        &self,
+        slot: &[Option<Ring>],
+        k: usize,
+        alive: &[bool],
+    ) -> Option<(Host, Resplit)> {
+        let r = slot[k].as_ref()?;
+        let good = |u: &Ring| self.good(u).then(|| quad_fit(&u.pts));
+        let key = |s: &Resplit| s.1[0].pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
+        let mut hosts = vec![(Host::Alone, r.clone())];
+        let mut hosts2 = Vec::new();
+        let mut pairs = Vec::new();
+        for (j, c, u) in self.neighbour_unions(slot, k, alive) {
+            hosts.push((Host::Merged { j, c }, u.clone()));
+            // the union as block k, the neighbour's slot empty, the shared cut dead
+            let mut slot2 = slot.to_vec();
+            slot2[k] = Some(u);
+            slot2[j] = None;
+            let mut alive2 = alive.to_vec();
+            alive2[c] = false;
+            for (j2, c2, u2) in self.neighbour_unions(&slot2, k, &alive2) {
+                if !pairs.contains(&(j2.min(j), j2.max(j))) {
+                    pairs.push((j2.min(j), j2.max(j)));
+                    hosts2.push((Host::Merged2 { j, c, j2, c2 }, u2));
+                }
+            }
+        }
+        hosts.append(&mut hosts2);
+        let mut best: Option<(Host, Resplit)> = None;
+        for (host, u) in hosts {
+            // the fewest blocks disturbed: two neighbours only when no re-split of the block
+            // alone or with one neighbour works
+            if matches!(host, Host::Merged2 { .. }) && best.is_some() {
+                break;
+            }
+            // a good neighbour may not come out with a worse corner score than RESPLIT_SLACK
+            // above the worst good block it replaces (gulf-of-mexico: the repair of a small
+            // block re-cornered the 39-vertex central basin, F 0.13 → 0.20, whose transfinite
+            // grid then folded over more area than it covered)
+            let olds = match host {
+                Host::Alone => vec![k],
+                Host::Merged { j, .. } => vec![k, j],
+                Host::Merged2 { j, j2, .. } => vec![k, j, j2],
             };
-            if let Some((s, split)) = option {
-                let key = u.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
-                let better = best.as_ref().is_none_or(|b| {
-                    s < b.0 - 1e-12
-                        || ((s - b.0).abs() <= 1e-12 && {
-                            let kb = b.4.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
-                            (key.x, key.y) < (kb.x, kb.y)
+            let limit = olds
+                .iter()
+                .filter_map(|&s| slot[s].as_ref().filter(|r| self.good(r)))
+                .map(|r| quad_fit(&r.pts) + RESPLIT_SLACK)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let limit = if limit.is_finite() {
+                limit
+            } else {
+                f64::INFINITY
+            };
+            let good = |u: &Ring| good(u).filter(|&f| f <= limit);
+            let two = matches!(host, Host::Merged2 { .. })
+                .then(|| self.best_split_by(&u, &good))
+                .flatten()
+                .map(|(s, a, b, ends)| {
+                    let first = |r: Ring| retag(r, TMP_CUT, TMP_CUT2);
+                    (s, vec![first(a), first(b)], vec![ends])
+                });
+            for s in two.into_iter().chain(self.best_split3(&u, &good)) {
+                let better = best.as_ref().is_none_or(|(_, b)| {
+                    s.0 < b.0 - 1e-12
+                        || ((s.0 - b.0).abs() <= 1e-12 && {
+                            let (ks, kb) = (key(&s), key(b));
+                            (ks.x, ks.y) < (kb.x, kb.y)
                         })
                 });
                 if better {
-                    best = Some((s, j, c, split, u));
+                    best = Some((host, s));
                 }
             }
         }
         best
+    }
+
+    /// Applies a re-split found by [`Builder::best_resplit`]: the merged cuts die, the children
+    /// take the slots of the host's blocks in order (block `k` first), a third child of fewer
+    /// host blocks gets a new slot and a leaf in the tree, a host block left without a child
+    /// is merged into `k`.
+    fn apply_resplit(
+        &mut self,
+        slot: &mut Vec<Option<Ring>>,
+        owner: &mut Vec<usize>,
+        alive: &mut Vec<bool>,
+        k: usize,
+        (host, (_, children, ends)): (Host, Resplit),
+    ) {
+        let (children, ids) = self.commit_resplit(children, &ends);
+        alive.extend(ids.iter().map(|_| true));
+        let mut slots = match host {
+            Host::Alone => vec![k],
+            Host::Merged { j, c } => {
+                alive[c] = false;
+                vec![k, j]
+            }
+            Host::Merged2 { j, c, j2, c2 } => {
+                alive[c] = false;
+                alive[c2] = false;
+                vec![k, j, j2]
+            }
+        };
+        let n = children.len();
+        for (i, child) in children.into_iter().enumerate() {
+            if i < slots.len() {
+                slot[slots[i]] = Some(child);
+            } else {
+                slot.push(Some(child));
+                let m = slot.len() - 1;
+                owner.push(m);
+                self.branch_leaf(slots[i - 1], m, ids[i - 1]);
+                slots.push(m);
+            }
+        }
+        for &s in &slots[n..] {
+            slot[s] = None;
+            owner[s] = k;
+        }
     }
 
     /// Cost of a block for the **relaxed** repair of blocks that would get a corner inside a
@@ -398,7 +662,7 @@ impl Builder<'_> {
         }
     }
 
-    /// Step 3 of the repair (issue #6): every block that would still get a corner inside a
+    /// Step 4 of the repair (issue #6): every block that would still get a corner inside a
     /// cut (a cut joint: a block bounded by cuts without four usable corners, whose
     /// triangle-block rule cannot insert on the original boundary) is split, or merged with a
     /// neighbour (and the union re-split), into blocks that take their corners without one —
@@ -455,7 +719,16 @@ impl Builder<'_> {
         let mut alive = vec![true; self.cuts.len()];
         let mut k = 0;
         let mut budget = 4 * slot.len() + 16;
-        while k < slot.len() && budget > 0 {
+        // a repair changes the neighbours of blocks already passed over: sweep again while
+        // the last sweep changed something (and the budget lasts)
+        let mut changed = false;
+        while budget > 0 {
+            if k >= slot.len() {
+                if !changed {
+                    break;
+                }
+                (k, changed) = (0, false);
+            }
             let Some(r) = slot[k].clone() else {
                 k += 1;
                 continue;
@@ -473,12 +746,23 @@ impl Builder<'_> {
                 slot.push(Some(b));
                 owner.push(slot.len() - 1);
                 self.branch_leaf(k, slot.len() - 1, id);
+                changed = true;
                 continue;
             }
             // 2. merge with a neighbour, possibly followed by a split
             let good = |u: &Ring| self.good(u).then(|| quad_fit(&u.pts));
-            match self.best_merge(&slot, k, &alive, &good) {
-                Some(m) => self.apply_merge(&mut slot, &mut owner, &mut alive, k, m),
+            if let Some(m) = self.best_merge(&slot, k, &alive, &good) {
+                self.apply_merge(&mut slot, &mut owner, &mut alive, k, m);
+                changed = true;
+                continue;
+            }
+            // 3. the block alone or merged with one neighbour, by two cuts into three good
+            //    blocks; merged with two neighbours, by one or two cuts
+            match self.best_resplit(&slot, k, &alive) {
+                Some(t) => {
+                    self.apply_resplit(&mut slot, &mut owner, &mut alive, k, t);
+                    changed = true;
+                }
                 None => k += 1,
             }
         }
@@ -612,6 +896,52 @@ mod tests {
                 (a - 8.0).abs() < 1e-12 || (a - 4.0).abs() < 1e-12,
                 "area {a}"
             );
+        }
+    }
+
+    #[test]
+    fn u_shaped_block_needs_two_cuts() {
+        // U = 3×3 square minus the 1×2 slot (1,1)–(2,3): κ₁ = (16 − 12)/16 = 0.25 > τ₁⁻, so it
+        // needs a repair. Every single cut leaves a child with a reflex vertex and κ₁ ≥ 0.1
+        // (an L or the U itself), so steps 1–2 find nothing (no neighbours to merge with);
+        // step 3 must split it by two cuts into three rectangles (four usable 90° corners
+        // each), with areas adding up to 9 − 2 = 7.
+        let u = [
+            (0., 0.),
+            (3., 0.),
+            (3., 3.),
+            (2., 3.),
+            (2., 1.),
+            (1., 1.),
+            (1., 3.),
+            (0., 3.),
+        ];
+        let region = Region::new(u.iter().map(|&(x, y)| v(x, y)).collect(), vec![]).unwrap();
+        let opts = DecomposeOptions::default();
+        let mut b = Builder::new(&region, &opts);
+        let block = ring(&u, &[B; 8]);
+        assert!(b.needs_repair(&block));
+        assert!(b.best_split(&block).is_none());
+        let out = b.repair_pass(vec![block]);
+        assert_eq!(out.len(), 3, "{out:?}");
+        assert_eq!(b.cuts.len(), 2);
+        let mut total = 0.0;
+        for r in &out {
+            assert!(b.good(r), "{:?}", r.pts);
+            // a rectangle: every corner the best fit picks is a right angle
+            let (c, _) = select_corners(&r.pts, &opts.corner_weights).expect("four corners");
+            for &i in &c {
+                let n = r.len();
+                let (p, a, q) = (r.pts[(i + n - 1) % n], r.pts[i], r.pts[(i + 1) % n]);
+                assert!((p - a).dot(q - a).abs() < 1e-12, "{:?} at {a:?}", r.pts);
+            }
+            total += crate::geom::signed_area(&r.pts);
+        }
+        assert!((total - 7.0).abs() < 1e-12, "area {total}");
+        // each new cut has both ends on the region boundary and length 1 (the slot's depth
+        // from a reflex vertex to the opposite side, or across an arm)
+        for &(p, q) in &b.cuts {
+            assert!((p.distance(q) - 1.0).abs() < 1e-12, "{p:?}–{q:?}");
         }
     }
 
