@@ -256,21 +256,70 @@ pub fn simplify(
     Ok(())
 }
 
-/// `unamalla decompose`.
-pub fn decompose(path: &Path, from: Option<&Path>, out: &Path, svg: Option<&Path>) -> Result<()> {
-    let region = read_region(path)?;
-    let d = match from {
+/// Arguments of `unamalla decompose`.
+pub struct DecomposeArgs {
+    pub region: PathBuf,
+    pub from: Option<PathBuf>,
+    pub output: PathBuf,
+    pub svg: Option<PathBuf>,
+    pub no_simplify: bool,
+    pub cells: usize,
+}
+
+/// `unamalla decompose`: the automatic decomposition (or a file's, validated) of the region
+/// `unamalla mesh` would decompose — the mesher's default simplification and feature removal
+/// for about `cells` cells ([`Mesher::prepare_region`]) — or of the region as read with
+/// `no_simplify`. A `from` file that does not fit the simplified region is tried on the region
+/// as read (a file made by hand for the original rings).
+pub fn decompose(a: DecomposeArgs) -> Result<()> {
+    if a.cells == 0 {
+        bail!("--cells must be at least 1");
+    }
+    let raw = read_region(&a.region)?;
+    let region = if a.no_simplify {
+        raw.clone()
+    } else {
+        let prepared = Mesher::new().cells(a.cells).prepare_region(&raw)?;
+        eprintln!(
+            "simplified: {} → {} vertices",
+            raw.rings().map(|r| r.len()).sum::<usize>(),
+            prepared.mesh_region.rings().map(|r| r.len()).sum::<usize>()
+        );
+        prepared.mesh_region
+    };
+    let (d, region) = match &a.from {
         Some(f) => {
             let text =
                 std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
-            Decomposition::from_json(&text, &region)?
+            match Decomposition::from_json(&text, &region) {
+                Ok(d) => (d, region),
+                Err(e1) if a.no_simplify || region == raw => return Err(e1.into()),
+                Err(e1) => match Decomposition::from_json(&text, &raw) {
+                    Ok(d) => (d, raw),
+                    Err(e2) => bail!(
+                        "{}: fits neither the simplified region ({e1}) nor the region as read ({e2})",
+                        f.display()
+                    ),
+                },
+            }
         }
-        None => dec::decompose(&region, &dec::DecomposeOptions::default())?,
+        None => (
+            dec::decompose(&region, &dec::DecomposeOptions::default())?,
+            region,
+        ),
     };
-    write_text(out, &d.to_json())?;
-    if let Some(p) = svg {
+    write_text(&a.output, &d.to_json())?;
+    if let Some(p) = &a.svg {
         write_text(p, &d.to_svg(&region))?;
     }
-    eprintln!("{} blocks, {} cuts", d.blocks.len(), d.cuts.len());
+    let tol = dec::Tolerances::default();
+    let admissible = (0..d.blocks.len())
+        .filter(|&b| d.block_admissible(b, &tol))
+        .count();
+    eprintln!(
+        "{} blocks, {} cuts, {admissible} admissible",
+        d.blocks.len(),
+        d.cuts.len()
+    );
     Ok(())
 }

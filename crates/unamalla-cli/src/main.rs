@@ -9,7 +9,8 @@
 //! * `unamalla eval <mesh> --functional NAME [--omega w] [--k k] [--raw] [--json]`
 //! * `unamalla smooth <mesh> [--functional NAME] [--solver tn-tr|tn-ls|lbfgs|pointwise] -o out`
 //! * `unamalla simplify <region> --method NAME [--epsilon e] [--delta d] -o out.geojson [--svg f]`
-//! * `unamalla decompose <region> [--from file.json] -o decomposition.json [--svg out.svg]`
+//! * `unamalla decompose <region> [--from file.json] [--no-simplify] [--cells N] -o decomposition.json [--svg out.svg]`
+//!   (decomposes the region `unamalla mesh` would: its default simplification first)
 //! * `unamalla counts <problem.json> [--density d | --cell-size h] [-o counts.json]`
 //! * `unamalla bspline <region> [--degree 1|2] [--net NxM] [--blocks] [--samples K] -o <outdir>`
 //! * `unamalla hex <case|facedir> [--size m,n,p] [--perturb s | --nonconvex N] [--seed k]
@@ -194,6 +195,14 @@ enum Command {
         /// Picture of the decomposition.
         #[arg(long)]
         svg: Option<PathBuf>,
+        /// Decompose the region as read. By default it is first simplified exactly as
+        /// `unamalla mesh` does (contour simplification, then removal of boundary features
+        /// below the cell size of `--cells`), so the file fits `unamalla mesh --decomposition`.
+        #[arg(long)]
+        no_simplify: bool,
+        /// Cell count the feature removal is sized for, as `unamalla mesh --cells`.
+        #[arg(long, default_value_t = 20_000)]
+        cells: usize,
     },
     /// Compatible point counts of a compatibility problem (JSON), with pinned counts honoured.
     Counts(counts::CountsArgs),
@@ -337,7 +346,16 @@ fn run(cli: Cli) -> Result<()> {
             from,
             output,
             svg,
-        } => commands::decompose(&region, from.as_deref(), &output, svg.as_deref())?,
+            no_simplify,
+            cells,
+        } => commands::decompose(commands::DecomposeArgs {
+            region,
+            from,
+            output,
+            svg,
+            no_simplify,
+            cells,
+        })?,
         Command::Counts(args) => counts::run(args)?,
         Command::Bspline(args) => bspline::run(args)?,
         Command::Hex(args) => hex::run(args)?,

@@ -255,3 +255,80 @@ fn eval_raw_length_on_a_hand_written_grid() {
     assert!(v["gradient_norm"].as_f64().unwrap().abs() < 1e-12, "{v}");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// `unamalla decompose` decomposes the region `unamalla mesh` would (the mesher's default
+/// simplification: maryland 260 → 99 vertices, every block admissible — the decompose crate's
+/// fixture test checks the same blocks), writes a file that `--from` validates, and with
+/// `--no-simplify` decomposes the rings as read; a file for the rings as read is also accepted
+/// by `--from` without `--no-simplify` (it does not fit the simplified region).
+#[test]
+fn decompose_writes_the_meshers_decomposition() {
+    let dir = tmpdir("decompose");
+    let (json, svg) = (dir.join("d.json"), dir.join("d.svg"));
+    let st = bin()
+        .arg("decompose")
+        .arg(fixture("maryland.geojson"))
+        .arg("-o")
+        .arg(&json)
+        .arg("--svg")
+        .arg(&svg)
+        .run_ok();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(err.contains("simplified: 260 → 99 vertices"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let blocks = v["blocks"].as_array().unwrap().len();
+    let cuts = v["cuts"].as_array().unwrap().len();
+    // a simply connected region: the block graph is a tree
+    assert_eq!(cuts, blocks - 1);
+    assert!(
+        err.contains(&format!(
+            "{blocks} blocks, {cuts} cuts, {blocks} admissible"
+        )),
+        "{err}"
+    );
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    // the saved file validates against the same region
+    let again = dir.join("again.json");
+    bin()
+        .arg("decompose")
+        .arg(fixture("maryland.geojson"))
+        .arg("--from")
+        .arg(&json)
+        .arg("-o")
+        .arg(&again)
+        .run_ok();
+    assert_eq!(
+        serde_json::from_slice::<serde_json::Value>(&std::fs::read(&again).unwrap()).unwrap()
+            ["blocks"],
+        v["blocks"]
+    );
+    // the rings as read: every block vertex of the file lies on the raw region, which has
+    // 260 vertices, so the blocks' rings hold more than the 99 simplified ones
+    let raw = dir.join("raw.json");
+    bin()
+        .arg("decompose")
+        .arg(fixture("maryland.geojson"))
+        .arg("--no-simplify")
+        .arg("-o")
+        .arg(&raw)
+        .run_ok();
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&raw).unwrap()).unwrap();
+    let vertices = |v: &serde_json::Value| -> usize {
+        v["blocks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["ring"].as_array().unwrap().len())
+            .sum()
+    };
+    assert!(vertices(&r) > vertices(&v) && vertices(&r) >= 260);
+    bin()
+        .arg("decompose")
+        .arg(fixture("maryland.geojson"))
+        .arg("--from")
+        .arg(&raw)
+        .arg("-o")
+        .arg(dir.join("raw-again.json"))
+        .run_ok();
+    std::fs::remove_dir_all(dir).ok();
+}
