@@ -257,12 +257,26 @@ pub fn simplify(
 }
 
 /// Arguments of `unamalla decompose`.
+#[derive(clap::Args, Debug)]
 pub struct DecomposeArgs {
+    /// Region file (GeoJSON).
     pub region: PathBuf,
+    /// Start from (or validate) this decomposition file.
+    #[arg(long)]
     pub from: Option<PathBuf>,
+    /// Output decomposition JSON.
+    #[arg(short, long)]
     pub output: PathBuf,
+    /// Picture of the decomposition.
+    #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Decompose the region as read. By default it is first simplified exactly as
+    /// `unamalla mesh` does (contour simplification, then removal of boundary features below
+    /// the cell size of `--cells`), so the file fits `unamalla mesh --decomposition`.
+    #[arg(long)]
     pub no_simplify: bool,
+    /// Cell count the feature removal is sized for, as `unamalla mesh --cells`.
+    #[arg(long, default_value_t = 20_000)]
     pub cells: usize,
 }
 

@@ -183,27 +183,7 @@ enum Command {
         svg: Option<PathBuf>,
     },
     /// Decompose a region into admissible four-sided blocks.
-    Decompose {
-        /// Region file (GeoJSON).
-        region: PathBuf,
-        /// Start from (or validate) this decomposition file.
-        #[arg(long)]
-        from: Option<PathBuf>,
-        /// Output decomposition JSON.
-        #[arg(short, long)]
-        output: PathBuf,
-        /// Picture of the decomposition.
-        #[arg(long)]
-        svg: Option<PathBuf>,
-        /// Decompose the region as read. By default it is first simplified exactly as
-        /// `unamalla mesh` does (contour simplification, then removal of boundary features
-        /// below the cell size of `--cells`), so the file fits `unamalla mesh --decomposition`.
-        #[arg(long)]
-        no_simplify: bool,
-        /// Cell count the feature removal is sized for, as `unamalla mesh --cells`.
-        #[arg(long, default_value_t = 20_000)]
-        cells: usize,
-    },
+    Decompose(commands::DecomposeArgs),
     /// Compatible point counts of a compatibility problem (JSON), with pinned counts honoured.
     Counts(counts::CountsArgs),
     /// B-spline parametrization (bilinear or biquadratic) of a region from a convex control net,
@@ -341,21 +321,7 @@ fn run(cli: Cli) -> Result<()> {
             output,
             svg,
         } => commands::simplify(&region, &method, epsilon, delta, &output, svg.as_deref())?,
-        Command::Decompose {
-            region,
-            from,
-            output,
-            svg,
-            no_simplify,
-            cells,
-        } => commands::decompose(commands::DecomposeArgs {
-            region,
-            from,
-            output,
-            svg,
-            no_simplify,
-            cells,
-        })?,
+        Command::Decompose(args) => commands::decompose(args)?,
         Command::Counts(args) => counts::run(args)?,
         Command::Bspline(args) => bspline::run(args)?,
         Command::Hex(args) => hex::run(args)?,
