@@ -293,14 +293,13 @@ pub fn decompose(a: DecomposeArgs) -> Result<()> {
     let region = if a.no_simplify {
         raw.clone()
     } else {
-        let prepared = Mesher::new().cells(a.cells).prepare_region(&raw)?;
-        eprintln!(
-            "simplified: {} → {} vertices",
-            raw.rings().map(|r| r.len()).sum::<usize>(),
-            prepared.mesh_region.rings().map(|r| r.len()).sum::<usize>()
-        );
-        prepared.mesh_region
+        Mesher::new()
+            .cells(a.cells)
+            .prepare_region(&raw)?
+            .mesh_region
     };
+    let vertices = |r: &Region| r.rings().map(|p| p.len()).sum::<usize>();
+    let raw_vertices = vertices(&raw);
     let (d, region) = match &a.from {
         Some(f) => {
             let text =
@@ -330,6 +329,8 @@ pub fn decompose(a: DecomposeArgs) -> Result<()> {
     let admissible = (0..d.blocks.len())
         .filter(|&b| d.block_admissible(b, &tol))
         .count();
+    // the notes only on success: a failure is one `error:` line
+    eprintln!("region: {raw_vertices} → {} vertices", vertices(&region));
     eprintln!(
         "{} blocks, {} cuts, {admissible} admissible",
         d.blocks.len(),

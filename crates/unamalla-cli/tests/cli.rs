@@ -274,7 +274,7 @@ fn decompose_writes_the_meshers_decomposition() {
         .arg(&svg)
         .run_ok();
     let err = String::from_utf8_lossy(&st.stderr);
-    assert!(err.contains("simplified: 260 → 99 vertices"), "{err}");
+    assert!(err.contains("region: 260 → 99 vertices"), "{err}");
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let blocks = v["blocks"].as_array().unwrap().len();
     let cuts = v["cuts"].as_array().unwrap().len();
