@@ -54,6 +54,12 @@ pub trait Problem: Send + Sync {
     fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]);
     /// The local model of mesh node `node`; `None` if the node is fixed or out of range.
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel>;
+    /// Only the value of [`local`](Self::local) (the part of F that depends on `node`): what the
+    /// pointwise solver's line search needs for each trial position. The default computes the
+    /// whole local model; implementations override it with a value-only evaluation.
+    fn local_value(&self, x: &[f64], node: usize) -> Option<f64> {
+        self.local(x, node).map(|m| m.value)
+    }
     /// Number of elements measured by [`element_measures`](Self::element_measures)
     /// (corner triangles in 2D, tetrahedra in 3D).
     fn num_elements(&self) -> usize;

@@ -556,6 +556,85 @@ fn scalars(p: &[DVec2; 4], c: usize, k: usize) -> (DVec2, DVec2, TriScalars) {
     )
 }
 
+/// Node-only local model of cell node `node`: for each of its cells, the corner triangles
+/// (and the diagonal pair) that involve it contribute their gradient and the node's 2 × 2
+/// block of their leg Hessian, `H_ii = s_a²·H_aa + s_a s_b·(H_ab + H_ba) + s_b²·H_bb` with
+/// `s_a`, `s_b` ∈ {−1, 0, 1} the node's signs in the legs `a`, `b` (the block that
+/// [`scatter_leg_hessian`] would add at `(i, i)`, without the cell's 8 × 8 matrix).
+fn node_model<K: TriKernel>(
+    k: &K,
+    t: Terms,
+    topo: &QuadTopology,
+    x: &[f64],
+    node: usize,
+) -> Option<LocalModel> {
+    let asm = &topo.asm;
+    let mut m = LocalModel {
+        value: 0.0,
+        grad: [0.0; 3],
+        hess: [[0.0; 3]; 3],
+        dim: 2,
+    };
+    let (lo, hi) = pair_range(t);
+    for &c in &asm.inc[asm.inc_offsets[node]..asm.inc_offsets[node + 1]] {
+        let c = c as usize;
+        let i = asm.cells[c].iter().position(|&v| v as usize == node)?;
+        let (p, _) = topo.cell_points(x, c);
+        for q in node_pairs(i, lo, hi) {
+            let l = LEGS[q];
+            let sign = |to: usize, from: usize| {
+                f64::from(u8::from(l[to] == i)) - f64::from(u8::from(l[from] == i))
+            };
+            let (sa, sb) = (sign(1, 0), sign(3, 2));
+            let (a, b, s) = scalars(&p, c, q);
+            let d = k.eval(&s, Order::Hessian);
+            m.value += d.v;
+            let (ga, gb) = leg_grads(a, b, &d.g);
+            let gi = sa * ga + sb * gb;
+            m.grad[0] += gi.x;
+            m.grad[1] += gi.y;
+            let hu = leg_hessian(a, b, &d);
+            for dx in 0..2 {
+                for dy in 0..2 {
+                    m.hess[dx][dy] += sa * sa * hu[dx][dy]
+                        + sa * sb * (hu[dx][2 + dy] + hu[2 + dx][dy])
+                        + sb * sb * hu[2 + dx][2 + dy];
+                }
+            }
+        }
+    }
+    Some(m)
+}
+
+/// The value of [`node_model`] alone (value-only kernel evaluations).
+fn node_value<K: TriKernel>(
+    k: &K,
+    t: Terms,
+    topo: &QuadTopology,
+    x: &[f64],
+    node: usize,
+) -> Option<f64> {
+    let asm = &topo.asm;
+    let (lo, hi) = pair_range(t);
+    let mut v = 0.0;
+    for &c in &asm.inc[asm.inc_offsets[node]..asm.inc_offsets[node + 1]] {
+        let c = c as usize;
+        let i = asm.cells[c].iter().position(|&w| w as usize == node)?;
+        let (p, _) = topo.cell_points(x, c);
+        for q in node_pairs(i, lo, hi) {
+            v += k.value(&scalars(&p, c, q).2);
+        }
+    }
+    Some(v)
+}
+
+/// The leg pairs in `lo..hi` ([`pair_range`]) whose triangle involves cell node `i`: every
+/// corner triangle except the one at the opposite corner `i + 2`, and the diagonal pair.
+#[inline(always)]
+fn node_pairs(i: usize, lo: usize, hi: usize) -> impl Iterator<Item = usize> {
+    (lo..hi).filter(move |&q| !(q < 4 && q == (i + 2) & 3))
+}
+
 #[inline(always)]
 fn pair_range(t: Terms) -> (usize, usize) {
     match (t.corners, t.diagonal) {
@@ -657,26 +736,19 @@ fn cell_grad<K: TriKernel>(k: &K, t: Terms, p: &[DVec2; 4], c: usize, g: &mut [D
     v
 }
 
-/// Value, gradient and 8×8 Hessian of the terms of cell `c`; with `only = Some(i)` the corner
-/// triangle not containing local node `i` is skipped.
+/// Value, gradient and 8×8 Hessian of the terms of cell `c`.
 #[inline(always)]
 fn cell_hess<K: TriKernel>(
     k: &K,
     t: Terms,
     p: &[DVec2; 4],
     c: usize,
-    only: Option<usize>,
     g: &mut [DVec2; 4],
     h: &mut [[f64; 8]; 8],
 ) -> f64 {
     let (lo, hi) = pair_range(t);
     let mut v = 0.0;
     for q in lo..hi {
-        if let Some(i) = only {
-            if q < 4 && q == (i + 2) & 3 {
-                continue;
-            }
-        }
         let (a, b, s) = scalars(p, c, q);
         let d = k.eval(&s, Order::Hessian);
         v += d.v;
@@ -982,7 +1054,7 @@ impl<K: TriKernel> QuadFunctional<K> {
         self.topo.assemble_cell_hessians(x, h, false, |c, p| {
             let mut lg = [DVec2::ZERO; 4];
             let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, p, c, None, &mut lg, &mut lh);
+            cell_hess(&self.kernel, self.terms, p, c, &mut lg, &mut lh);
             (lh, 0.0)
         });
     }
@@ -1000,7 +1072,7 @@ impl<K: TriKernel> QuadFunctional<K> {
             let (p, vars) = self.topo.cell_points(x, c);
             let mut lg = [DVec2::ZERO; 4];
             let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, &p, c, None, &mut lg, &mut lh);
+            cell_hess(&self.kernel, self.terms, &p, c, &mut lg, &mut lh);
             let mut lv = [0.0; 8];
             for i in 0..4 {
                 if vars[i] != FIXED {
@@ -1106,6 +1178,7 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
             0.0
         }));
     }
+    /// Node-only local model ([`node_model`]), with the kernel of the fast evaluator's plan.
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         self.topo.var_of(node)?;
         assert_eq!(
@@ -1113,29 +1186,12 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
             self.topo.num_vars(),
             "local: x has the wrong length"
         );
-        let asm = &self.topo.asm;
-        let mut m = LocalModel {
-            value: 0.0,
-            grad: [0.0; 3],
-            hess: [[0.0; 3]; 3],
-            dim: 2,
-        };
-        for &c in &asm.inc[asm.inc_offsets[node]..asm.inc_offsets[node + 1]] {
-            let c = c as usize;
-            let i = asm.cells[c].iter().position(|&v| v as usize == node)?;
-            let (p, _) = self.topo.cell_points(x, c);
-            let mut lg = [DVec2::ZERO; 4];
-            let mut lh = [[0.0; 8]; 8];
-            m.value += cell_hess(&self.kernel, self.terms, &p, c, Some(i), &mut lg, &mut lh);
-            m.grad[0] += lg[i].x;
-            m.grad[1] += lg[i].y;
-            for dx in 0..2 {
-                for dy in 0..2 {
-                    m.hess[dx][dy] += lh[2 * i + dx][2 * i + dy];
-                }
-            }
-        }
-        Some(m)
+        with_plan!(self, k, t => node_model(k, t, &self.topo, x, node))
+    }
+
+    fn local_value(&self, x: &[f64], node: usize) -> Option<f64> {
+        self.topo.var_of(node)?;
+        with_plan!(self, k, t => node_value(k, t, &self.topo, x, node))
     }
 
     fn num_elements(&self) -> usize {

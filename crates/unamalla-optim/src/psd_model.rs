@@ -63,6 +63,9 @@ impl<K: TriKernel> Problem for PsdModel<'_, K> {
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         self.f.local(x, node)
     }
+    fn local_value(&self, x: &[f64], node: usize) -> Option<f64> {
+        self.f.local_value(x, node)
+    }
     fn num_elements(&self) -> usize {
         self.f.num_elements()
     }

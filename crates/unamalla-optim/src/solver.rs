@@ -997,11 +997,13 @@ fn pointwise<P: Problem + ?Sized>(
                         }
                         let mut old = [0.0; 3];
                         old[..dim].copy_from_slice(&xr[dim * v..dim * v + dim]);
+                        // the same value-only evaluation as the trials below
+                        let val = problem.local_value(xr, free[v]).unwrap_or(m.value);
                         Some(Prop {
                             v,
                             d,
                             old,
-                            val: m.value,
+                            val,
                             gd,
                             t: 1.0,
                             done: false,
@@ -1021,10 +1023,12 @@ fn pointwise<P: Problem + ?Sized>(
                         .filter(|p| !p.done)
                         .for_each(|p| {
                             let node = free[p.v];
-                            let acc = problem.local(xr, node).is_some_and(|m| {
-                                m.value.is_finite() && m.value <= p.val + 1e-4 * p.t * p.gd
-                            }) && (!guard
-                                || local_guard.is_none_or(|lg| lg.node_min_alpha(xr, node) > thr));
+                            let acc = problem
+                                .local_value(xr, node)
+                                .is_some_and(|v| v.is_finite() && v <= p.val + 1e-4 * p.t * p.gd)
+                                && (!guard
+                                    || local_guard
+                                        .is_none_or(|lg| lg.node_min_alpha(xr, node) > thr));
                             if acc {
                                 p.done = true;
                             } else {

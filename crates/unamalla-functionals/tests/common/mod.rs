@@ -136,6 +136,15 @@ pub fn check_problem<P: Problem>(name: &str, p: &P, x: &[f64], tol: f64) -> Resu
             .local(x, node)
             .ok_or_else(|| format!("{name}: no local model for free node {node}"))?;
         assert_eq!(p.var_of(node), Some(j));
+        let lv = p
+            .local_value(x, node)
+            .ok_or_else(|| format!("{name}: no local value for free node {node}"))?;
+        if !close(lv, m.value, 1e-12, m.value.abs()) {
+            return Err(format!(
+                "{name}: local_value {lv} vs local model value {} at node {node}",
+                m.value
+            ));
+        }
         for a in 0..d {
             if !close(m.grad[a], g[d * j + a], 1e-10, gscale) {
                 return Err(format!("{name}: local grad of node {node} differs"));
