@@ -558,9 +558,8 @@ fn scalars(p: &[DVec2; 4], c: usize, k: usize) -> (DVec2, DVec2, TriScalars) {
 
 /// Node-only local model of cell node `node`: for each of its cells, the corner triangles
 /// (and the diagonal pair) that involve it contribute their gradient and the node's 2 × 2
-/// block of their leg Hessian, `H_ii = s_a²·H_aa + s_a s_b·(H_ab + H_ba) + s_b²·H_bb` with
-/// `s_a`, `s_b` ∈ {−1, 0, 1} the node's signs in the legs `a`, `b` (the block that
-/// [`scatter_leg_hessian`] would add at `(i, i)`, without the cell's 8 × 8 matrix).
+/// block of their leg Hessian ([`node_block`]: the block that [`scatter_leg_hessian`] would
+/// add at `(i, i)`, without the 4 × 4 leg Hessian or the cell's 8 × 8 matrix).
 fn node_model<K: TriKernel>(
     k: &K,
     t: Terms,
@@ -593,17 +592,48 @@ fn node_model<K: TriKernel>(
             let gi = sa * ga + sb * gb;
             m.grad[0] += gi.x;
             m.grad[1] += gi.y;
-            let hu = leg_hessian(a, b, &d);
+            let h = node_block(a, b, sa, sb, &d);
             for dx in 0..2 {
                 for dy in 0..2 {
-                    m.hess[dx][dy] += sa * sa * hu[dx][dy]
-                        + sa * sb * (hu[dx][2 + dy] + hu[2 + dx][dy])
-                        + sb * sb * hu[2 + dx][2 + dy];
+                    m.hess[dx][dy] += h[dx][dy];
                 }
             }
         }
     }
     Some(m)
+}
+
+/// The 2 × 2 block of a leg pair's Hessian for a node that moves both legs by `s_a·δx`,
+/// `s_b·δx` (`s_a`, `s_b` ∈ {−1, 0, 1}: `+1` at a leg's head, `−1` at its tail):
+/// `Pᵀ·H_u·P` with `P = [s_a I; s_b I]`. With `J_n = ∂s/∂x` (rows α, |a|², |b|², a·b:
+/// `s_a(b_y, −b_x) + s_b(−a_y, a_x)`, `2s_a a`, `2s_b b`, `s_a b + s_b a`) it is
+/// `J_nᵀ·(∂²f/∂s²)·J_n + 2(f_{|a|²} s_a² + f_{|b|²} s_b² + f_{a·b} s_a s_b)·I` — the second
+/// derivative of α contributes `s_a s_b·(A + Aᵀ) = 0` (A the rotation block).
+#[inline(always)]
+fn node_block(a: DVec2, b: DVec2, sa: f64, sb: f64, d: &Partials) -> [[f64; 2]; 2] {
+    let j = [
+        sa * DVec2::new(b.y, -b.x) + sb * DVec2::new(-a.y, a.x),
+        (2.0 * sa) * a,
+        (2.0 * sb) * b,
+        sa * b + sb * a,
+    ];
+    let mut hj = [DVec2::ZERO; 4]; // (∂²f/∂s²)·J_n, row by row
+    for (r, row) in hj.iter_mut().enumerate() {
+        for (t, jt) in j.iter().enumerate() {
+            *row += d.h[r][t] * *jt;
+        }
+    }
+    let diag = 2.0 * (d.g[1] * sa * sa + d.g[2] * sb * sb + d.g[3] * sa * sb);
+    let mut out = [[0.0; 2]; 2];
+    for (r, jr) in j.iter().enumerate() {
+        out[0][0] += jr.x * hj[r].x;
+        out[0][1] += jr.x * hj[r].y;
+        out[1][0] += jr.y * hj[r].x;
+        out[1][1] += jr.y * hj[r].y;
+    }
+    out[0][0] += diag;
+    out[1][1] += diag;
+    out
 }
 
 /// The value of [`node_model`] alone (value-only kernel evaluations).
