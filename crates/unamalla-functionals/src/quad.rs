@@ -1208,7 +1208,8 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
             0.0
         }));
     }
-    /// Node-only local model ([`node_model`]), with the kernel of the fast evaluator's plan.
+    /// Node-only local model (the node's 2 × 2 block of its leg pairs' Hessians, no 8 × 8 cell
+    /// matrix), with the kernel of the fast evaluator's plan.
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         self.topo.var_of(node)?;
         assert_eq!(
