@@ -567,39 +567,32 @@ fn node_model<K: TriKernel>(
     x: &[f64],
     node: usize,
 ) -> Option<LocalModel> {
-    let asm = &topo.asm;
     let mut m = LocalModel {
         value: 0.0,
         grad: [0.0; 3],
         hess: [[0.0; 3]; 3],
         dim: 2,
     };
-    let (lo, hi) = pair_range(t);
-    for &c in &asm.inc[asm.inc_offsets[node]..asm.inc_offsets[node + 1]] {
-        let c = c as usize;
-        let i = asm.cells[c].iter().position(|&v| v as usize == node)?;
-        let (p, _) = topo.cell_points(x, c);
-        for q in node_pairs(i, lo, hi) {
-            let l = LEGS[q];
-            let sign = |to: usize, from: usize| {
-                f64::from(u8::from(l[to] == i)) - f64::from(u8::from(l[from] == i))
-            };
-            let (sa, sb) = (sign(1, 0), sign(3, 2));
-            let (a, b, s) = scalars(&p, c, q);
-            let d = k.eval(&s, Order::Hessian);
-            m.value += d.v;
-            let (ga, gb) = leg_grads(a, b, &d.g);
-            let gi = sa * ga + sb * gb;
-            m.grad[0] += gi.x;
-            m.grad[1] += gi.y;
-            let h = node_block(a, b, sa, sb, &d);
-            for dx in 0..2 {
-                for dy in 0..2 {
-                    m.hess[dx][dy] += h[dx][dy];
-                }
+    for_each_node_pair(t, topo, x, node, |p, c, q, i| {
+        let l = LEGS[q];
+        let sign = |to: usize, from: usize| {
+            f64::from(u8::from(l[to] == i)) - f64::from(u8::from(l[from] == i))
+        };
+        let (sa, sb) = (sign(1, 0), sign(3, 2));
+        let (a, b, s) = scalars(p, c, q);
+        let d = k.eval(&s, Order::Hessian);
+        m.value += d.v;
+        let (ga, gb) = leg_grads(a, b, &d.g);
+        let gi = sa * ga + sb * gb;
+        m.grad[0] += gi.x;
+        m.grad[1] += gi.y;
+        let h = node_block(a, b, sa, sb, &d);
+        for dx in 0..2 {
+            for dy in 0..2 {
+                m.hess[dx][dy] += h[dx][dy];
             }
         }
-    }
+    })?;
     Some(m)
 }
 
@@ -644,18 +637,35 @@ fn node_value<K: TriKernel>(
     x: &[f64],
     node: usize,
 ) -> Option<f64> {
+    let mut v = 0.0;
+    for_each_node_pair(t, topo, x, node, |p, c, q, _| {
+        v += k.value(&scalars(p, c, q).2);
+    })?;
+    Some(v)
+}
+
+/// Calls `f(cell points, cell, leg pair, local index of the node)` for every leg pair (in
+/// `pair_range(t)`) of every cell around mesh node `node` whose triangle involves the node
+/// ([`node_pairs`]); `None` if the incidence table is inconsistent.
+#[inline(always)]
+fn for_each_node_pair(
+    t: Terms,
+    topo: &QuadTopology,
+    x: &[f64],
+    node: usize,
+    mut f: impl FnMut(&[DVec2; 4], usize, usize, usize),
+) -> Option<()> {
     let asm = &topo.asm;
     let (lo, hi) = pair_range(t);
-    let mut v = 0.0;
     for &c in &asm.inc[asm.inc_offsets[node]..asm.inc_offsets[node + 1]] {
         let c = c as usize;
-        let i = asm.cells[c].iter().position(|&w| w as usize == node)?;
+        let i = asm.cells[c].iter().position(|&v| v as usize == node)?;
         let (p, _) = topo.cell_points(x, c);
         for q in node_pairs(i, lo, hi) {
-            v += k.value(&scalars(&p, c, q).2);
+            f(&p, c, q, i);
         }
     }
-    Some(v)
+    Some(())
 }
 
 /// The leg pairs in `lo..hi` ([`pair_range`]) whose triangle involves cell node `i`: every
