@@ -83,21 +83,14 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     }
     mesher = mesher.simplify((!a.no_simplify).then_some(sopts));
     if let Some(f) = &a.decomposition {
-        let text =
-            std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
         // a saved decomposition fits the region without small features; one made by hand for
         // the simplified region (`unamalla simplify`) fits that one
         let prepared = mesher.prepare_region(&region)?;
-        let d = match Decomposition::from_json(&text, &prepared.mesh_region) {
-            Ok(d) => d,
-            Err(e1) if prepared.simplified == prepared.mesh_region => return Err(e1.into()),
-            Err(e1) => Decomposition::from_json(&text, &prepared.simplified).map_err(|e2| {
-                anyhow::anyhow!(
-                    "{}: fits neither the meshed region ({e1}) nor the simplified region ({e2})",
-                    f.display()
-                )
-            })?,
-        };
+        let (d, _) = read_decomposition(
+            f,
+            ("the meshed region", &prepared.mesh_region),
+            ("the simplified region", &prepared.simplified),
+        )?;
         mesher = mesher.decomposition(d);
     }
     if !a.quiet {
@@ -256,6 +249,31 @@ pub fn simplify(
     Ok(())
 }
 
+/// Reads decomposition file `path` and validates it against region `first`, or, if it does
+/// not fit that one and `second` is a different region, against `second` (then the flag is
+/// `true`); the error names both regions (their labels) and why the file fits neither.
+fn read_decomposition(
+    path: &Path,
+    first: (&str, &Region),
+    second: (&str, &Region),
+) -> Result<(Decomposition, bool)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    match Decomposition::from_json(&text, first.1) {
+        Ok(d) => Ok((d, false)),
+        Err(e1) if first.1 == second.1 => Err(e1.into()),
+        Err(e1) => match Decomposition::from_json(&text, second.1) {
+            Ok(d) => Ok((d, true)),
+            Err(e2) => bail!(
+                "{}: fits neither {} ({e1}) nor {} ({e2})",
+                path.display(),
+                first.0,
+                second.0
+            ),
+        },
+    }
+}
+
 /// Arguments of `unamalla decompose`.
 #[derive(clap::Args, Debug)]
 pub struct DecomposeArgs {
@@ -302,19 +320,12 @@ pub fn decompose(a: DecomposeArgs) -> Result<()> {
     let raw_vertices = vertices(&raw);
     let (d, region) = match &a.from {
         Some(f) => {
-            let text =
-                std::fs::read_to_string(f).with_context(|| format!("reading {}", f.display()))?;
-            match Decomposition::from_json(&text, &region) {
-                Ok(d) => (d, region),
-                Err(e1) if a.no_simplify || region == raw => return Err(e1.into()),
-                Err(e1) => match Decomposition::from_json(&text, &raw) {
-                    Ok(d) => (d, raw),
-                    Err(e2) => bail!(
-                        "{}: fits neither the simplified region ({e1}) nor the region as read ({e2})",
-                        f.display()
-                    ),
-                },
-            }
+            let (d, fits_raw) = read_decomposition(
+                f,
+                ("the simplified region", &region),
+                ("the region as read", &raw),
+            )?;
+            (d, if fits_raw { raw } else { region })
         }
         None => (
             dec::decompose(&region, &dec::DecomposeOptions::default())?,

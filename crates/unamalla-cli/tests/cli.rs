@@ -330,5 +330,29 @@ fn decompose_writes_the_meshers_decomposition() {
         .arg("-o")
         .arg(dir.join("raw-again.json"))
         .run_ok();
+    // a file for another region fits neither: one error line naming both, no output
+    let other = dir.join("colorado.json");
+    bin()
+        .arg("decompose")
+        .arg(fixture("colorado.geojson"))
+        .arg("-o")
+        .arg(&other)
+        .run_ok();
+    let never = dir.join("never.json");
+    let (region, other, never_s) = (
+        fixture("maryland.geojson"),
+        other.to_string_lossy().into_owned(),
+        never.to_string_lossy().into_owned(),
+    );
+    let region = region.to_string_lossy();
+    let args = ["decompose", &region, "--from", &other, "-o", &never_s];
+    assert_clean_failure(&args, &never);
+    let st = bin().args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("fits neither the simplified region")
+            && err.contains("nor the region as read"),
+        "{err}"
+    );
     std::fs::remove_dir_all(dir).ok();
 }

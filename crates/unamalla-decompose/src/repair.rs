@@ -103,6 +103,26 @@ fn retag(mut r: Ring, from: usize, to: usize) -> Ring {
     r
 }
 
+/// `r` with the cut of a two-child split ([`TMP_CUT`]) re-tagged as the first cut of a
+/// [`Resplit`] ([`TMP_CUT2`]).
+fn as_first_cut(r: Ring) -> Ring {
+    retag(r, TMP_CUT, TMP_CUT2)
+}
+
+/// Whether candidate score `s` with tie-break key `key` beats the best so far (`best`):
+/// lower score, scores within 10⁻¹² broken by the key (coordinates, so that the choice does
+/// not depend on ring numbering).
+fn beats(s: f64, key: DVec2, best: Option<(f64, DVec2)>) -> bool {
+    best.is_none_or(|(b, kb)| {
+        s < b - 1e-12 || ((s - b).abs() <= 1e-12 && (key.x, key.y) < (kb.x, kb.y))
+    })
+}
+
+/// The sum of a ring's vertices: a tie-break key independent of where its numbering starts.
+fn ring_key(r: &Ring) -> DVec2 {
+    r.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p)
+}
+
 /// A split candidate: score, the two children (new cut tagged [`TMP_CUT`]), cut endpoints.
 type Split = (f64, Ring, Ring, (DVec2, DVec2));
 
@@ -140,6 +160,17 @@ enum Host {
     },
 }
 
+impl Host {
+    /// The slots of the blocks the host unites (block `k` first) and the cuts between them.
+    fn parts(self, k: usize) -> (Vec<usize>, Vec<usize>) {
+        match self {
+            Host::Alone => (vec![k], vec![]),
+            Host::Merged { j, c } => (vec![k, j], vec![c]),
+            Host::Merged2 { j, c, j2, c2 } => (vec![k, j, j2], vec![c, c2]),
+        }
+    }
+}
+
 impl Builder<'_> {
     /// Four usable corners (see the module documentation).
     pub(crate) fn usable(&self, ring: &[DVec2]) -> bool {
@@ -155,6 +186,12 @@ impl Builder<'_> {
             && critical_angles(&ring.pts, tol.theta_minus).is_empty()
             && concavity(&ring.pts).approximately_convex(tol)
             && self.usable(&ring.pts)
+    }
+
+    /// The corner score F of a good block ([`Builder::good`]); `None` if it is not good. The
+    /// acceptance of steps 1–3.
+    fn good_fit(&self, ring: &Ring) -> Option<f64> {
+        self.good(ring).then(|| quad_fit(&ring.pts))
     }
 
     /// `true` if block `ring` should be repaired: four or more vertices and fewer than four
@@ -180,7 +217,7 @@ impl Builder<'_> {
 
     /// The best cut splitting `ring` into two good blocks.
     fn best_split(&self, ring: &Ring) -> Option<Split> {
-        self.best_split_by(ring, &|r: &Ring| self.good(r).then(|| quad_fit(&r.pts)))
+        self.best_split_by(ring, &|r: &Ring| self.good_fit(r))
     }
 
     /// The best cut splitting `ring` into two blocks that `accept` takes; `accept` returns the
@@ -313,7 +350,6 @@ impl Builder<'_> {
     /// `½·max(F₁, F₂, F₃) + (F₁ + F₂ + F₃)/6 + pre₁ + pre₂` — the two-child score
     /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
     fn best_split3(&self, ring: &Ring, accept: &dyn Fn(&Ring) -> Option<f64>) -> Option<Resplit> {
-        let first = |r: Ring| retag(r, TMP_CUT, TMP_CUT2);
         let mut best: Option<Resplit> = None;
         for quarter_points in [false, true] {
             if quarter_points && (best.is_some() || !self.opts.edge_point_cuts) {
@@ -326,7 +362,8 @@ impl Builder<'_> {
                     (None, Some(fb)) => (b, fb, a),
                     _ => return,
                 };
-                let Some((s2, r1, r2, ends2)) = self.best_split_by(&first(rest), accept) else {
+                let Some((s2, r1, r2, ends2)) = self.best_split_by(&as_first_cut(rest), accept)
+                else {
                     return;
                 };
                 let (Some(f1), Some(f2)) = (accept(&r1), accept(&r2)) else {
@@ -335,7 +372,7 @@ impl Builder<'_> {
                 let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
                 let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
                 if best.as_ref().is_none_or(|b| s < b.0) {
-                    best = Some((s, vec![first(kept), r1, r2], vec![ends1, ends2]));
+                    best = Some((s, vec![as_first_cut(kept), r1, r2], vec![ends1, ends2]));
                 }
             });
         }
@@ -413,21 +450,18 @@ impl Builder<'_> {
         accept: &dyn Fn(&Ring) -> Option<f64>,
     ) -> Option<Merge> {
         let mut best: Option<Merge> = None;
-        for (j, c, u) in self.neighbour_unions(slot, k, alive) {
+        let r = slot[k].as_ref()?;
+        for (j, c, u) in self.neighbour_unions(slot, r, &[k], alive) {
             let option = match accept(&u) {
                 Some(cost) => Some((cost, None)),
                 None => self.best_split_by(&u, accept).map(|s| (s.0, Some(s))),
             };
             if let Some((s, split)) = option {
-                let key = u.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
-                let better = best.as_ref().is_none_or(|b| {
-                    s < b.0 - 1e-12
-                        || ((s - b.0).abs() <= 1e-12 && {
-                            let kb = b.4.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
-                            (key.x, key.y) < (kb.x, kb.y)
-                        })
-                });
-                if better {
+                if beats(
+                    s,
+                    ring_key(&u),
+                    best.as_ref().map(|b| (b.0, ring_key(&b.4))),
+                ) {
                     best = Some((s, j, c, split, u));
                 }
             }
@@ -435,18 +469,16 @@ impl Builder<'_> {
         best
     }
 
-    /// The unions of block slot `k` with each neighbour across one live, unprotected cut
-    /// (the two blocks share exactly that cut's endpoints), as (neighbour slot, cut, union);
-    /// degenerate or clockwise unions are left out.
+    /// The unions of ring `r` (a block, or a union of the blocks in slots `exclude`) with each
+    /// other block across one live, unprotected cut (the two share exactly that cut's
+    /// endpoints), as (neighbour slot, cut, union); degenerate or clockwise unions are left out.
     fn neighbour_unions(
         &self,
         slot: &[Option<Ring>],
-        k: usize,
+        r: &Ring,
+        exclude: &[usize],
         alive: &[bool],
     ) -> Vec<(usize, usize, Ring)> {
-        let Some(r) = slot[k].as_ref() else {
-            return Vec::new();
-        };
         let mut out = Vec::new();
         for (e, t) in r.tags.iter().enumerate() {
             let Tag::Cut(c) = *t else { continue };
@@ -455,7 +487,7 @@ impl Builder<'_> {
             }
             let Some((j, f)) = slot.iter().enumerate().find_map(|(j, o)| {
                 let o = o.as_ref()?;
-                if j == k {
+                if exclude.contains(&j) {
                     return None;
                 }
                 o.tags
@@ -493,27 +525,21 @@ impl Builder<'_> {
         alive: &[bool],
     ) -> Option<(Host, Resplit)> {
         let r = slot[k].as_ref()?;
-        let good = |u: &Ring| self.good(u).then(|| quad_fit(&u.pts));
-        let key = |s: &Resplit| s.1[0].pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p);
         let mut hosts = vec![(Host::Alone, r.clone())];
         let mut hosts2 = Vec::new();
         let mut pairs = Vec::new();
-        for (j, c, u) in self.neighbour_unions(slot, k, alive) {
-            hosts.push((Host::Merged { j, c }, u.clone()));
-            // the union as block k, the neighbour's slot empty, the shared cut dead
-            let mut slot2 = slot.to_vec();
-            slot2[k] = Some(u);
-            slot2[j] = None;
-            let mut alive2 = alive.to_vec();
-            alive2[c] = false;
-            for (j2, c2, u2) in self.neighbour_unions(&slot2, k, &alive2) {
+        for (j, c, u) in self.neighbour_unions(slot, r, &[k], alive) {
+            for (j2, c2, u2) in self.neighbour_unions(slot, &u, &[k, j], alive) {
                 if !pairs.contains(&(j2.min(j), j2.max(j))) {
                     pairs.push((j2.min(j), j2.max(j)));
                     hosts2.push((Host::Merged2 { j, c, j2, c2 }, u2));
                 }
             }
+            hosts.push((Host::Merged { j, c }, u));
         }
         hosts.append(&mut hosts2);
+        // corner scores of the good blocks among the hosts' blocks, each computed once
+        let mut fits: Vec<(usize, Option<f64>)> = Vec::new();
         let mut best: Option<(Host, Resplit)> = None;
         for (host, u) in hosts {
             // the fewest blocks disturbed: two neighbours only when no re-split of the block
@@ -525,38 +551,34 @@ impl Builder<'_> {
             // above the worst good block it replaces (gulf-of-mexico: the repair of a small
             // block re-cornered the 39-vertex central basin, F 0.13 → 0.20, whose transfinite
             // grid then folded over more area than it covered)
-            let olds = match host {
-                Host::Alone => vec![k],
-                Host::Merged { j, .. } => vec![k, j],
-                Host::Merged2 { j, j2, .. } => vec![k, j, j2],
-            };
-            let limit = olds
-                .iter()
-                .filter_map(|&s| slot[s].as_ref().filter(|r| self.good(r)))
-                .map(|r| quad_fit(&r.pts) + RESPLIT_SLACK)
-                .fold(f64::NEG_INFINITY, f64::max);
-            let limit = if limit.is_finite() {
-                limit
-            } else {
-                f64::INFINITY
-            };
-            let good = |u: &Ring| good(u).filter(|&f| f <= limit);
+            let mut limit = f64::NEG_INFINITY;
+            for s in host.parts(k).0 {
+                let f = match fits.iter().find(|f| f.0 == s) {
+                    Some(&(_, f)) => f,
+                    None => {
+                        let f = slot[s].as_ref().and_then(|r| self.good_fit(r));
+                        fits.push((s, f));
+                        f
+                    }
+                };
+                if let Some(f) = f {
+                    limit = limit.max(f + RESPLIT_SLACK);
+                }
+            }
+            if limit == f64::NEG_INFINITY {
+                limit = f64::INFINITY;
+            }
+            let good = |u: &Ring| self.good_fit(u).filter(|&f| f <= limit);
             let two = matches!(host, Host::Merged2 { .. })
                 .then(|| self.best_split_by(&u, &good))
                 .flatten()
-                .map(|(s, a, b, ends)| {
-                    let first = |r: Ring| retag(r, TMP_CUT, TMP_CUT2);
-                    (s, vec![first(a), first(b)], vec![ends])
-                });
+                .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
             for s in two.into_iter().chain(self.best_split3(&u, &good)) {
-                let better = best.as_ref().is_none_or(|(_, b)| {
-                    s.0 < b.0 - 1e-12
-                        || ((s.0 - b.0).abs() <= 1e-12 && {
-                            let (ks, kb) = (key(&s), key(b));
-                            (ks.x, ks.y) < (kb.x, kb.y)
-                        })
-                });
-                if better {
+                if beats(
+                    s.0,
+                    ring_key(&s.1[0]),
+                    best.as_ref().map(|(_, b)| (b.0, ring_key(&b.1[0]))),
+                ) {
                     best = Some((host, s));
                 }
             }
@@ -578,18 +600,10 @@ impl Builder<'_> {
     ) {
         let (children, ids) = self.commit_resplit(children, &ends);
         alive.extend(ids.iter().map(|_| true));
-        let mut slots = match host {
-            Host::Alone => vec![k],
-            Host::Merged { j, c } => {
-                alive[c] = false;
-                vec![k, j]
-            }
-            Host::Merged2 { j, c, j2, c2 } => {
-                alive[c] = false;
-                alive[c2] = false;
-                vec![k, j, j2]
-            }
-        };
+        let (mut slots, merged) = host.parts(k);
+        for c in merged {
+            alive[c] = false;
+        }
         let n = children.len();
         for (i, child) in children.into_iter().enumerate() {
             if i < slots.len() {
@@ -618,8 +632,8 @@ impl Builder<'_> {
         if crate::geom::signed_area(&ring.pts) < 0.1 * self.min_area {
             return None;
         }
-        if self.good(ring) {
-            return Some(quad_fit(&ring.pts));
+        if let Some(f) = self.good_fit(ring) {
+            return Some(f);
         }
         let triangle = triangle_plan(ring, tol.theta_minus, self.opts);
         if triangle.as_ref().is_some_and(|t| t.1) {
@@ -750,8 +764,7 @@ impl Builder<'_> {
                 continue;
             }
             // 2. merge with a neighbour, possibly followed by a split
-            let good = |u: &Ring| self.good(u).then(|| quad_fit(&u.pts));
-            if let Some(m) = self.best_merge(&slot, k, &alive, &good) {
+            if let Some(m) = self.best_merge(&slot, k, &alive, &|u: &Ring| self.good_fit(u)) {
                 self.apply_merge(&mut slot, &mut owner, &mut alive, k, m);
                 changed = true;
                 continue;

@@ -70,7 +70,7 @@ fn pipeline_regions_meet_the_corner_rules() {
         .collect();
     files.sort();
     let tol = Tolerances::default();
-    let (mut blocks, mut admissible, mut straight) = (0, 0, 0);
+    let (mut blocks, mut straight) = (0, 0);
     for f in files {
         let (raw, _) = read_region_geojson_cleaned(&f, PartSelector::Largest).unwrap();
         let region = pipeline::pipeline_simplify(&raw);
@@ -98,9 +98,8 @@ fn pipeline_regions_meet_the_corner_rules() {
             "{}: blocks {bad:?} not admissible",
             f.display()
         );
-        admissible += d.blocks.len() - bad.len();
     }
-    eprintln!("admissible {admissible}/{blocks}, straight corners {straight}");
+    eprintln!("{blocks} blocks, all admissible; straight corners {straight}");
     assert_eq!(straight, 0, "{straight} corners ≥ 170°");
 }
 
