@@ -2,7 +2,7 @@
 //! from the TFI grid and/or coarse-to-fine ([`smooth_coarse_to_fine`], ratio 3), and print a
 //! Markdown table.
 //!
-//! `cargo run --release -p unamalla-optim --example large_grid -- SIZES [SOLVERS] [MODE] [PRECOND]`
+//! `cargo run --release -p unamalla-optim --example large_grid -- SIZES [SOLVERS] [MODE] [PRECOND] [HESSIAN] [FTOL] [GTOL] [SIGMA]`
 //! * `SIZES`: nodes per side, e.g. `100,301,1000`;
 //! * `SOLVERS`: e.g. `tn-tr,tn-ls` (default all four);
 //! * `MODE`: `direct`, `c2f` or `both` (default `both`; coarse-to-fine needs `(n−1)` divisible
@@ -11,7 +11,8 @@
 //!   `block-jacobi`, `jacobi`, `none`;
 //! * `HESSIAN`: `exact` (default) or `psd` (the PSD-projected model Hessian,
 //!   [`HessianMode::ProjectedPsd`]);
-//! * `FTOL`: the finest level's FTOL (default 1e-9); `GTOL`: relative GTOL (default 0 = off).
+//! * `FTOL`: the finest level's FTOL (default 1e-9); `GTOL`: relative GTOL (default 0 = off);
+//! * `SIGMA`: σ of (6.8) (default 0.1).
 //!
 //! The time column is wall time; `cpu` (in the per-level lines and after the table row) is
 //! the process CPU time (user + system, all threads) from `/proc/self/stat`.
@@ -29,7 +30,7 @@ use unamalla_mesh::StructuredGrid2;
 use unamalla_optim::fixtures::sinusoidal;
 use unamalla_optim::{
     smooth, smooth_coarse_to_fine, CoarseToFineOptions, HessianMode, NullObserver, Preconditioner,
-    SmoothOptions, Solver, SolverOptions,
+    SmoothFunctional, SmoothOptions, Solver, SolverOptions,
 };
 
 /// CPU time of this process (user + system, all threads) in seconds, from `/proc/self/stat`
@@ -95,13 +96,21 @@ fn main() {
     };
     let ftol: f64 = args.get(6).map_or(1e-9, |s| s.parse().expect("ftol"));
     let gtol: f64 = args.get(7).map_or(0.0, |s| s.parse().expect("gtol"));
+    let sigma: f64 = args.get(8).map_or(0.1, |s| s.parse().expect("sigma"));
     println!(
         "| nodes | solver | preconditioner | start | iterations | CG iterations | time [s] | final α₋/ᾱ | F | status |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for &n in &sizes {
         for &s in &solvers {
-            let opts = options(s, pre, hessian, ftol, gtol);
+            let opts = SmoothOptions {
+                functional: SmoothFunctional::BlockSmoothing {
+                    sigma,
+                    density: 1.0,
+                    layers: 2,
+                },
+                ..options(s, pre, hessian, ftol, gtol)
+            };
             let pname = if matches!(s, Solver::TnTr | Solver::TnLs) {
                 let h = if hessian == HessianMode::ProjectedPsd {
                     "PSD model"

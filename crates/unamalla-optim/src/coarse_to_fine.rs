@@ -167,6 +167,50 @@ fn reset_boundary(g: &mut StructuredGrid2, exact: &StructuredGrid2) {
     }
 }
 
+/// The start of a finer level from a coarser result (module docs, steps 3 and 4): `coarse`
+/// refined by bilinear interpolation (`ratio − 1` new lines per cell), then the exact boundary
+/// of `fine` (a grid of the finer size, e.g. its TFI start) put back by the transfinite
+/// correction of the boundary displacement.
+///
+/// Errors: `ratio < 2`, or sizes that do not match (`m_fine − 1 = ratio·(m_coarse − 1)`, the
+/// same for `n`).
+///
+/// ```
+/// use unamalla_optim::coarse_to_fine::prolongate;
+/// use unamalla_optim::fixtures::sinusoidal;
+///
+/// let coarse = sinusoidal(11, 11, 0.1, 2.0)?;
+/// let fine = sinusoidal(31, 31, 0.1, 2.0)?;
+/// let p = prolongate(&coarse, &fine, 3)?;
+/// assert_eq!((p.m(), p.n()), (31, 31));
+/// assert_eq!(p.node(0, 7), fine.node(0, 7)); // the exact boundary
+/// assert!((p.node(15, 15) - coarse.node(5, 5)).length() < 1e-12); // coarse nodes stay
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn prolongate(
+    coarse: &StructuredGrid2,
+    fine: &StructuredGrid2,
+    ratio: usize,
+) -> Result<StructuredGrid2, OptimError> {
+    if ratio < 2 {
+        return Err(OptimError::InvalidOption {
+            name: "ratio",
+            value: ratio as f64,
+            reason: "the refinement ratio must be at least 2",
+        });
+    }
+    if fine.m() - 1 != ratio * (coarse.m() - 1) || fine.n() - 1 != ratio * (coarse.n() - 1) {
+        return Err(OptimError::InvalidOption {
+            name: "ratio",
+            value: ratio as f64,
+            reason: "the fine grid must have ratio·(m − 1) + 1 × ratio·(n − 1) + 1 nodes of the coarse grid's m × n",
+        });
+    }
+    let mut f = coarse.refined(ratio - 1, ratio - 1)?;
+    reset_boundary(&mut f, fine);
+    Ok(f)
+}
+
 /// Smooths `grid` coarse-to-fine (module docs). `grid` is the start (e.g. the TFI grid of the
 /// region) and is overwritten with the result. Errors as [`smooth`] (invalid options, no free
 /// nodes, a boundary enclosing no area) and for a ratio below 2.
@@ -226,8 +270,7 @@ pub fn smooth_coarse_to_fine(
         let mut g = match cur.take() {
             None => plain.clone(),
             Some(c) => {
-                let mut f = c.refined(opts.ratio - 1, opts.ratio - 1)?;
-                reset_boundary(&mut f, &plain);
+                let f = prolongate(&c, &plain, opts.ratio)?;
                 let (q, _) = quality(&f)?;
                 if q <= eps && quality(&plain)?.0 > eps {
                     restarted = true;
@@ -358,6 +401,22 @@ mod tests {
         let (q, bad) = quality(&g).expect("quality");
         assert_eq!(bad, 0);
         assert!(q > 0.01);
+    }
+
+    #[test]
+    fn prolongate_checks_the_sizes() {
+        let coarse = sinusoidal(11, 11, 0.1, 2.0).expect("grid");
+        let fine = sinusoidal(31, 31, 0.1, 2.0).expect("grid");
+        assert!(prolongate(&coarse, &fine, 3).is_ok());
+        for r in [1, 2, 4] {
+            assert!(
+                matches!(
+                    prolongate(&coarse, &fine, r),
+                    Err(OptimError::InvalidOption { name: "ratio", .. })
+                ),
+                "ratio {r}"
+            );
+        }
     }
 
     #[test]
