@@ -1293,7 +1293,13 @@ mod tests {
         assert_eq!(d.non_hex_interior_cells, 0);
         assert!(d.max_abs_cos <= 1e-3, "max|cos| {}", d.max_abs_cos);
         assert!(b.continuation_steps <= 6, "{} steps", b.continuation_steps);
+        // the run says why it ended (it used to read "STOP by MAXITER condition")
+        assert_eq!(b.status, "Convex grid, STOP by PLANARITY condition");
         let t = run(CoplanarityOptions::thesis());
+        assert_ne!(
+            t.algorithm_b.as_ref().unwrap().status,
+            "Convex grid, STOP by PLANARITY condition"
+        );
         assert_eq!(t.algorithm_b.as_ref().unwrap().continuation_steps, 12);
         assert!(b.iterations < t.algorithm_b.as_ref().unwrap().iterations);
     }

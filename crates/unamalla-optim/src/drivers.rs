@@ -731,6 +731,13 @@ pub fn coplanarity_continuation(
         done |= planar(x);
         mu *= 0.1;
     }
+    // a continuation cut short because the faces are planar ends with that reason, whatever
+    // stopped its last μ step (FTOL, MAXITER, …)
+    if done {
+        if let Some(r) = last.as_mut() {
+            r.reason = StopReason::Planar;
+        }
+    }
     if last.is_none() {
         messages.push(Status::InitialGood);
     }
@@ -787,7 +794,10 @@ fn coplanarity_step(
         }
         if planar(x) {
             *done = true;
-            return Ok(merged);
+            return Ok(crate::solver::SolveResult {
+                reason: StopReason::Planar,
+                ..merged
+            });
         }
     }
 }

@@ -33,12 +33,19 @@ pub enum StopReason {
     LineSearch(LineSearchFailure),
     /// The trust radius collapsed (reported with the "rounding errors" message of Table A.2).
     TrustRadius,
+    /// Algorithm B's planarity stop: every penalized face is planar to the requested
+    /// tolerance, so the continuation ended early (not in Table A.2; spelled like its
+    /// messages, "Convex grid, STOP by PLANARITY condition").
+    Planar,
 }
 
 impl StopReason {
-    /// `true` for the ideal endings (FTOL, GTOL).
+    /// `true` for the ideal endings (FTOL, GTOL, and the planarity stop of Algorithm B).
     pub fn converged(self) -> bool {
-        matches!(self, StopReason::Ftol | StopReason::Gtol)
+        matches!(
+            self,
+            StopReason::Ftol | StopReason::Gtol | StopReason::Planar
+        )
     }
 }
 
@@ -91,6 +98,8 @@ impl fmt::Display for Status {
                     (StopReason::Gtol, false) => "Non convex grid, STOP by GTOL condition",
                     (StopReason::MaxIter, true) => "Convex grid, STOP by MAXITER condition",
                     (StopReason::MaxIter, false) => "Non convex grid, STOP by MAXITER condition",
+                    (StopReason::Planar, true) => "Convex grid, STOP by PLANARITY condition",
+                    (StopReason::Planar, false) => "Non convex grid, STOP by PLANARITY condition",
                     (StopReason::User, true) => "Convex grid, STOP by user",
                     (StopReason::User, false) => "Non convex grid, STOP by user",
                     (StopReason::LineSearch(L::Xtol), _) => {

@@ -93,6 +93,11 @@ fn status_messages_are_unamalla_table_a2() {
         st(StopReason::MaxIter, false),
         "Non convex grid, STOP by MAXITER condition"
     );
+    assert_eq!(
+        st(StopReason::Planar, true),
+        "Convex grid, STOP by PLANARITY condition"
+    );
+    assert!(StopReason::Planar.converged());
     assert_eq!(st(StopReason::User, true), "Convex grid, STOP by user");
     assert_eq!(
         st(StopReason::LineSearch(LineSearchFailure::Xtol), true),
