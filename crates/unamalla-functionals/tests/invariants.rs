@@ -498,7 +498,9 @@ fn a_hessian_of_another_pattern_is_rejected() {
 ///   `8(1 − c)(3 + c)` (≈ `16θ²`, second order).
 ///
 /// So smooth `(1, −1)` waves cost `(1 − c)/(3 + c) ≈ θ²/8` of the other polarization, and only
-/// `H_ω` (isotropic: both quotients equal) bounds them from below — the reason the (6.8)
+/// `H_ω` bounds them from below. `H_ω` is isotropic: at the identity Winslow's `l/α` has the
+/// second variation `|∇u|² − 2 det ∇u` (expand `(2 + 2 div u + |∇u|²)/(1 + div u + det ∇u)`),
+/// and `det ∇u` sums to zero with the boundary fixed, so both quotients are equal — the reason the (6.8)
 /// optimum at σ = 0.1 is so flat (docs/benchmarks.md, issue #4). The waves are multiplied by
 /// the envelope `sin(πi/(n−1))·sin(πj/(n−1))` so that they vanish on the fixed boundary; its
 /// frequency `π/(n−1)` is small against θ, hence the 5 % tolerance.

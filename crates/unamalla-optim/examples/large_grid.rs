@@ -62,8 +62,14 @@ fn options(
     hessian: HessianMode,
     ftol: f64,
     gtol: f64,
+    sigma: f64,
 ) -> SmoothOptions {
     SmoothOptions {
+        functional: SmoothFunctional::BlockSmoothing {
+            sigma,
+            density: 1.0,
+            layers: 2,
+        },
         solver: SolverOptions {
             max_iter: 500,
             ftol,
@@ -103,14 +109,7 @@ fn main() {
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for &n in &sizes {
         for &s in &solvers {
-            let opts = SmoothOptions {
-                functional: SmoothFunctional::BlockSmoothing {
-                    sigma,
-                    density: 1.0,
-                    layers: 2,
-                },
-                ..options(s, pre, hessian, ftol, gtol)
-            };
+            let opts = options(s, pre, hessian, ftol, gtol, sigma);
             let pname = if matches!(s, Solver::TnTr | Solver::TnLs) {
                 let h = if hessian == HessianMode::ProjectedPsd {
                     "PSD model"

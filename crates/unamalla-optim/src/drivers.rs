@@ -794,10 +794,7 @@ fn coplanarity_step(
         }
         if planar(x) {
             *done = true;
-            return Ok(crate::solver::SolveResult {
-                reason: StopReason::Planar,
-                ..merged
-            });
+            return Ok(merged);
         }
     }
 }
