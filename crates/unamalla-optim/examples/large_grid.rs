@@ -65,11 +65,7 @@ fn options(
     sigma: f64,
 ) -> SmoothOptions {
     SmoothOptions {
-        functional: SmoothFunctional::BlockSmoothing {
-            sigma,
-            density: 1.0,
-            layers: 2,
-        },
+        functional: SmoothFunctional::block_smoothing(sigma),
         solver: SolverOptions {
             max_iter: 500,
             ftol,

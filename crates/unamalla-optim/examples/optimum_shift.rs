@@ -22,11 +22,7 @@ fn optimum(n: usize, sigma: f64) -> Result<(StructuredGrid2, f64), Box<dyn std::
     let mut g = sinusoidal(n, n, 0.1, 2.0)?;
     let co = CoarseToFineOptions {
         smooth: SmoothOptions {
-            functional: SmoothFunctional::BlockSmoothing {
-                sigma,
-                density: 1.0,
-                layers: 2,
-            },
+            functional: SmoothFunctional::block_smoothing(sigma),
             solver: SolverOptions {
                 max_iter: 500,
                 ftol: 1e-6,

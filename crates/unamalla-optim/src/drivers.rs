@@ -941,13 +941,21 @@ pub enum SmoothFunctional {
     OmegaContinuation,
 }
 
-impl Default for SmoothFunctional {
-    fn default() -> Self {
+impl SmoothFunctional {
+    /// Plain (6.8) (boundary density 1, band of 2 layers) with weight `sigma` of `H_ω`.
+    pub fn block_smoothing(sigma: f64) -> Self {
         SmoothFunctional::BlockSmoothing {
-            sigma: 0.1,
+            sigma,
             density: 1.0,
             layers: 2,
         }
+    }
+}
+
+impl Default for SmoothFunctional {
+    /// (6.8) with σ = 0.1 (seed 000's Laguna Honda example).
+    fn default() -> Self {
+        SmoothFunctional::block_smoothing(0.1)
     }
 }
 
