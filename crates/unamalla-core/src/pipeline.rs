@@ -454,7 +454,20 @@ impl Mesher {
                 self.stage(Stage::Decompose, "decomposing into blocks");
                 let decomposition = match self.decomposition.take() {
                     Some(d) => d,
-                    None => decompose(&simplified, &self.decompose_opts)?,
+                    None => {
+                        // the chord layout samples the boundary at the cell size
+                        let mut opts = self.decompose_opts.clone();
+                        if opts.cell_size.is_none() {
+                            opts.cell_size = match self.size {
+                                MeshSize::Cells(n) => {
+                                    Some((simplified.area() / n.max(1) as f64).sqrt())
+                                }
+                                MeshSize::CellSize(h) => Some(h),
+                                MeshSize::Density(_) => None,
+                            };
+                        }
+                        decompose(&simplified, &opts)?
+                    }
                 };
                 lap(Stage::Decompose, &mut timer);
 

@@ -76,6 +76,28 @@ pub struct DecomposeOptions {
     /// of the cells against 88.6 % without, `mesh_region` example, 2026-11-22), so it is off
     /// by default.
     pub edge_point_cuts: bool,
+    /// Which layout places the first cuts (default [`Layout::Chords`]).
+    pub layout: Layout,
+    /// Aspect threshold T of a transverse chord cut: the smaller side must extend at least T
+    /// chord widths (default [`DEFAULT_ASPECT`](crate::chords::DEFAULT_ASPECT)).
+    pub chord_aspect: f64,
+    /// The cell size the mesh will have, if known: the chord layout samples the boundary at
+    /// most this far apart (default `None`: perimeter/1500).
+    pub cell_size: Option<f64>,
+}
+
+/// How the first cuts of a decomposition are placed (crate docs, "Layouts").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Layout {
+    /// The thesis's Algorithm 1 alone: hole removal (Algorithm 2) and concavity cuts
+    /// (Algorithm 3) from the deepest reflex vertices.
+    Concavity,
+    /// Hole bridges and transverse cuts chosen from the chords of the boundary's constrained
+    /// Delaunay triangulation (module `chords`), then Algorithm 1 on the pieces. [`decompose`]
+    /// falls back to [`Layout::Concavity`] when the chord layout cannot be built (the tree
+    /// then has no [`Step::Chord`] node); [`chord_layout`] reports the error instead.
+    #[default]
+    Chords,
 }
 
 impl Default for DecomposeOptions {
@@ -93,6 +115,9 @@ impl Default for DecomposeOptions {
             min_triangle_fraction: 1e-5,
             repair_corners: true,
             edge_point_cuts: false,
+            layout: Layout::default(),
+            chord_aspect: crate::chords::DEFAULT_ASPECT,
+            cell_size: None,
         }
     }
 }
@@ -104,9 +129,67 @@ pub fn decompose(
     region: &Region,
     opts: &DecomposeOptions,
 ) -> Result<Decomposition, DecomposeError> {
+    if opts.layout == Layout::Chords {
+        match chord_layout(region, opts) {
+            Ok(d) => return Ok(d),
+            Err(e) => {
+                if std::env::var_os("UNAMALLA_LAYOUT_DEBUG").is_some() {
+                    eprintln!("chord layout failed, falling back to the concavity layout: {e}");
+                }
+            }
+        }
+    }
     let mut b = Builder::new(region, opts);
     b.run_auto(0)?;
     b.finish()
+}
+
+/// The chord layout (module `chords`): its cuts first, then Algorithm 1 on every piece.
+pub fn chord_layout(
+    region: &Region,
+    opts: &DecomposeOptions,
+) -> Result<Decomposition, DecomposeError> {
+    let per = region.perimeter();
+    let spacing = opts
+        .cell_size
+        .unwrap_or(f64::INFINITY)
+        .min(per / 1500.0)
+        .max(per / 20000.0);
+    let cuts = crate::chords::layout_cuts(
+        region,
+        spacing,
+        opts.chord_aspect,
+        opts.min_area_fraction * region.area(),
+    )
+    .map_err(|e| DecomposeError::Layout(e.0))?;
+    let tol = crate::decomposition::boundary_tol(region);
+    let mut b = Builder::new(region, opts);
+    for (p, q) in cuts {
+        // a cut no piece admits (rounding at a sample point) is skipped: Algorithm 1 then
+        // treats that piece as it would without the layout
+        b.apply_cut(p, q, tol, Step::Chord);
+    }
+    b.protected_cuts = b.cuts.len();
+    let leaves: Vec<usize> = (0..b.nodes.len())
+        .filter(|&n| b.pieces[n].is_some())
+        .collect();
+    for n in leaves {
+        b.run_auto(n)?;
+    }
+    b.finish()
+}
+
+/// What [`Builder::apply_cut`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Applied {
+    /// The cut split a piece in two.
+    Split,
+    /// The cut joined a hole to its piece's outer ring.
+    Bridged,
+    /// The only piece admitting the cut has both ends on holes not yet joined.
+    JoinsTwoHoles,
+    /// No piece has both ends on its boundary and admits the cut.
+    NoPiece,
 }
 
 /// A candidate cut inside a piece.
@@ -203,6 +286,85 @@ impl<'a> Builder<'a> {
         self.nodes[node].cuts = cuts;
         self.pieces[node] = None;
         ids
+    }
+
+    /// Applies the straight cut `a`–`b` to the first leaf piece that has both points on its
+    /// boundary (within `tol`) and admits the cut: a split when both ends are on the piece's
+    /// outer ring, a bridge when one end is on a hole. Used by the decomposition file (user
+    /// cuts) and by the chord layout.
+    pub fn apply_cut(&mut self, a: DVec2, b: DVec2, tol: f64, step: Step) -> Applied {
+        let mut joins_holes = false;
+        for node in 0..self.nodes.len() {
+            let Some(piece) = self.pieces[node].as_ref() else {
+                continue;
+            };
+            let locate = |p: DVec2| -> Option<End> {
+                for (r, ring) in piece.rings().enumerate() {
+                    if let Some(i) = ring.pts.iter().position(|&x| x == p) {
+                        return Some(End {
+                            ring: r,
+                            pos: Pos::Vertex(i),
+                        });
+                    }
+                }
+                for (r, ring) in piece.rings().enumerate() {
+                    if let Some(i) = ring.pts.iter().position(|&x| x.distance(p) <= tol) {
+                        return Some(End {
+                            ring: r,
+                            pos: Pos::Vertex(i),
+                        });
+                    }
+                    for i in 0..ring.len() {
+                        if matches!(ring.tags[i], Tag::Boundary(_))
+                            && unamalla_mesh::geometry::point_segment_distance(
+                                p,
+                                ring.p(i),
+                                ring.next(i),
+                            ) <= tol
+                        {
+                            return Some(End {
+                                ring: r,
+                                pos: Pos::OnEdge(i, p),
+                            });
+                        }
+                    }
+                }
+                None
+            };
+            let (Some(e1), Some(e2)) = (locate(a), locate(b)) else {
+                continue;
+            };
+            let idx = piece.index();
+            if !piece.admissible(&idx, e1, e2) {
+                continue;
+            }
+            if e1.ring != 0 && e2.ring != 0 {
+                joins_holes = true;
+                continue;
+            }
+            let mut m = piece.clone();
+            let (x, y) = m.insert_ends(e1, e2);
+            let id = self.new_cut(m.ring(e1.ring).p(x), m.ring(e2.ring).p(y));
+            if e1.ring == 0 && e2.ring == 0 {
+                let (pa, pb) = m.split(x, y, id);
+                self.branch(node, step, vec![id], pa, pb);
+                return Applied::Split;
+            }
+            let (o, h, k) = if e1.ring == 0 {
+                (x, e2.ring, y)
+            } else {
+                (y, e1.ring, x)
+            };
+            m.merge(o, h, k, id);
+            self.pieces[node] = Some(m);
+            self.nodes[node].cuts.push(id);
+            return Applied::Bridged;
+        }
+        if joins_holes {
+            Applied::JoinsTwoHoles
+        } else {
+            Applied::NoPiece
+        }
     }
 
     pub fn new_cut(&mut self, a: DVec2, b: DVec2) -> usize {

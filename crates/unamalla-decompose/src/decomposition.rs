@@ -72,6 +72,8 @@ pub enum Step {
     CriticalAngle,
     /// A cut given in a decomposition file.
     User,
+    /// A cut of the chord layout (hole bridge or transverse cut, module `chords`).
+    Chord,
     /// A cut added by the corner repair (a block without four usable corners, module
     /// `repair`; beyond the thesis).
     CornerRepair,

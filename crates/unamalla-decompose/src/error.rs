@@ -11,6 +11,10 @@ pub enum DecomposeError {
         /// The hole.
         hole: usize,
     },
+    /// The chord layout could not be built (the triangulation of the boundary samples failed
+    /// or the rings are not connected by admissible chords).
+    #[error("chord layout: {0}")]
+    Layout(String),
     /// The decomposition file is not valid JSON or does not have the documented shape.
     #[error("decomposition file, line {line}, column {column}: {message}")]
     Json {

@@ -39,16 +39,14 @@
 //! is informative and ignored on input.
 
 use serde::{Deserialize, Serialize};
-use unamalla_mesh::geometry::point_segment_distance;
 use unamalla_mesh::{DVec2, Region};
 
-use crate::auto::{choose_corners, Builder, DecomposeOptions};
+use crate::auto::{choose_corners, Applied, Builder, DecomposeOptions};
 use crate::decomposition::{
     boundary_tol, check_corners, check_cuts, classify, Block, Cut, Decomposition, EdgeKind, Step,
     TreeNode,
 };
 use crate::error::DecomposeError;
-use crate::piece::{End, Pos, Tag};
 
 const FORMAT: &str = "unamalla-decomposition";
 
@@ -305,77 +303,21 @@ fn load_cuts(
     let tol = boundary_tol(region);
     let mut b = Builder::new(region, opts);
     for c in &cuts {
-        let mut applied = false;
-        for node in 0..b.nodes.len() {
-            let Some(piece) = b.pieces[node].clone() else {
-                continue;
-            };
-            let locate = |p: DVec2| -> Option<End> {
-                for (r, ring) in piece.rings().enumerate() {
-                    if let Some(i) = ring.pts.iter().position(|&x| x == p) {
-                        return Some(End {
-                            ring: r,
-                            pos: Pos::Vertex(i),
-                        });
-                    }
-                }
-                for (r, ring) in piece.rings().enumerate() {
-                    if let Some(i) = ring.pts.iter().position(|&x| x.distance(p) <= tol) {
-                        return Some(End {
-                            ring: r,
-                            pos: Pos::Vertex(i),
-                        });
-                    }
-                    for i in 0..ring.len() {
-                        if matches!(ring.tags[i], Tag::Boundary(_))
-                            && point_segment_distance(p, ring.p(i), ring.next(i)) <= tol
-                        {
-                            return Some(End {
-                                ring: r,
-                                pos: Pos::OnEdge(i, p),
-                            });
-                        }
-                    }
-                }
-                None
-            };
-            let (Some(e1), Some(e2)) = (locate(c.a), locate(c.b)) else {
-                continue;
-            };
-            let idx = piece.index();
-            if !piece.admissible(&idx, e1, e2) {
-                continue;
-            }
-            let mut m = piece.clone();
-            let (x, y) = m.insert_ends(e1, e2);
-            let id = b.new_cut(m.ring(e1.ring).p(x), m.ring(e2.ring).p(y));
-            if e1.ring == 0 && e2.ring == 0 {
-                let (pa, pb) = m.split(x, y, id);
-                b.branch(node, Step::User, vec![id], pa, pb);
-            } else if e1.ring == 0 || e2.ring == 0 {
-                let (o, h, k) = if e1.ring == 0 {
-                    (x, e2.ring, y)
-                } else {
-                    (y, e1.ring, x)
-                };
-                m.merge(o, h, k, id);
-                b.pieces[node] = Some(m);
-                b.nodes[node].cuts.push(id);
-            } else {
+        match b.apply_cut(c.a, c.b, tol, Step::User) {
+            Applied::Split | Applied::Bridged => {}
+            Applied::JoinsTwoHoles => {
                 return Err(DecomposeError::Format(format!(
                     "cut {}: joins two holes; join each hole to the outer boundary (or to a hole already joined to it)",
                     c.id
-                )));
+                )))
             }
-            applied = true;
-            break;
-        }
-        if !applied {
-            return Err(DecomposeError::Format(format!(
-                "cut {}: does not lie inside one piece of the decomposition made by the cuts before it \
-                 (it must join two boundary points of one piece)",
-                c.id
-            )));
+            Applied::NoPiece => {
+                return Err(DecomposeError::Format(format!(
+                    "cut {}: does not lie inside one piece of the decomposition made by the cuts before it \
+                     (it must join two boundary points of one piece)",
+                    c.id
+                )))
+            }
         }
     }
     b.protected_cuts = b.cuts.len();

@@ -161,6 +161,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod auto;
+pub mod chords;
 pub mod concavity;
 pub mod corners;
 mod decomposition;
@@ -172,7 +173,7 @@ mod render;
 mod repair;
 pub mod submap;
 
-pub use auto::{decompose, CutWeights, DecomposeOptions};
+pub use auto::{chord_layout, decompose, CutWeights, DecomposeOptions, Layout};
 pub use concavity::{concavity, critical_angles, is_admissible, Concavity, Pocket, Tolerances};
 pub use corners::{select_corners, CornerWeights};
 pub use decomposition::{Block, Cut, Decomposition, EdgeKind, SideCurve, Step, TreeNode};

@@ -1,0 +1,651 @@
+//! The chord layout: block-layout cuts chosen from the shape's chordal axis (module docs in
+//! the crate root, section "Chord layout").
+//!
+//! The boundary is sampled every `s`, the samples are triangulated by a constrained Delaunay
+//! triangulation (`spade`) with the rings as constraints, and the triangles inside the region
+//! are kept (parity flood from the convex hull). Every interior edge of that triangulation is a
+//! **chord**: a straight segment between two boundary points inside the region, and no two
+//! chords cross. The chords are the edges of the dual graph (triangles as nodes), whose
+//! spanning skeleton is the chordal axis of Prasad (1997). Cuts are taken from the chords:
+//!
+//! 1. **Hole bridges**: a minimum spanning tree of the rings (outer ring and holes), each
+//!    ring pair weighted by its cheapest chord `ℓ·(1 + ḡ)` (ℓ the chord length, ḡ the mean angle
+//!    penalty of the four new angles at its ends), then **closing chords** until every bridge
+//!    lies on a cycle of bridges (greedy by cost; a bridge that lies on no cycle would have the
+//!    same block on both sides). A chord that closes a cycle with a bridge of the same ring pair
+//!    must split the hole's perimeter into arcs of at least [`MIN_HOLE_ARC`] of it.
+//! 2. **Transverse cuts**: in each simply connected piece left by the bridges the dual graph is
+//!    a tree, so every chord c of length w splits the piece into two parts of areas A₁, A₂
+//!    (subtree sums). Its score is `min(A₁, A₂)/w²` — how many chord widths the smaller part
+//!    extends beyond the chord — discounted by `(1 − ½ḡ)`. The best chord is cut when its score
+//!    reaches the aspect threshold `T` ([`DEFAULT_ASPECT`]), and both parts are treated again.
+//!    The score is large at a **neck** (small w, both sides big: an arm or a peninsula is
+//!    separated at its neck) and at the middle of a long **channel** or elongated island (the
+//!    recursion cuts it into a chain of blocks whose length is at most ≈ 2T widths), and small
+//!    at small capes and inlets (a half disc at its base scores π/8 ≈ 0.39), which are left to
+//!    the block they belong to.
+//!
+//! Chords ending within `max(s, w/2)` of an earlier cut end are skipped (no fans), as are
+//! chords making an angle below [`MIN_END_ANGLE_DEG`] with the boundary.
+
+use std::collections::{BTreeMap, HashSet, VecDeque};
+use std::f64::consts::PI;
+
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use unamalla_mesh::{DVec2, Region};
+
+use crate::geom::{angle_penalty, left_angle};
+
+/// Default aspect threshold `T` of a transverse cut: the smaller side must extend at least
+/// `T` chord widths (area ≥ T·w²).
+pub const DEFAULT_ASPECT: f64 = 1.5;
+/// Smallest angle between a layout chord and the boundary at its ends.
+pub const MIN_END_ANGLE_DEG: f64 = 50.0;
+/// A closing chord of a ring pair that already has a bridge must leave arcs of at least this
+/// fraction of the hole's perimeter on either side of the two chords.
+pub const MIN_HOLE_ARC: f64 = 0.25;
+
+/// The triangulated region: boundary samples, inside triangles and their adjacency.
+pub(crate) struct ChordMesh {
+    /// Sample points.
+    pub pts: Vec<DVec2>,
+    /// Ring of each sample (0 outer, k hole k−1).
+    pub ring: Vec<usize>,
+    /// First sample of each ring (and the total count at the end).
+    pub ring_start: Vec<usize>,
+    /// Arc-length position of each sample along its ring.
+    pub arc: Vec<f64>,
+    /// Perimeter of each ring.
+    pub ring_len: Vec<f64>,
+    /// Inside triangles (sample indices).
+    pub tris: Vec<[usize; 3]>,
+    /// `nbr[t][k]`: the inside triangle across edge `(tris[t][k], tris[t][(k+1)%3])`, if that
+    /// edge is not a boundary edge.
+    pub nbr: Vec<[Option<usize>; 3]>,
+    /// Sample spacing.
+    pub spacing: f64,
+}
+
+/// Why the chord layout could not be computed (the caller falls back to the concavity
+/// layout).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ChordError(pub String);
+
+impl ChordMesh {
+    /// Samples every ring every `spacing` (original vertices kept) and triangulates.
+    pub fn new(region: &Region, spacing: f64) -> Result<Self, ChordError> {
+        let mut pts = Vec::new();
+        let mut ring = Vec::new();
+        let mut ring_start = Vec::new();
+        let mut arc = Vec::new();
+        let mut ring_len = Vec::new();
+        for (r, poly) in region.rings().enumerate() {
+            ring_start.push(pts.len());
+            let p = poly.points();
+            let n = p.len();
+            let mut s_acc = 0.0;
+            for i in 0..n {
+                let (a, b) = (p[i], p[(i + 1) % n]);
+                let len = a.distance(b);
+                let k = ((len / spacing).ceil() as usize).clamp(1, 1 << 20);
+                for j in 0..k {
+                    let t = j as f64 / k as f64;
+                    pts.push(a.lerp(b, t));
+                    ring.push(r);
+                    arc.push(s_acc + t * len);
+                }
+                s_acc += len;
+            }
+            ring_len.push(s_acc);
+        }
+        ring_start.push(pts.len());
+
+        let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+            ConstrainedDelaunayTriangulation::new();
+        let mut handles = Vec::with_capacity(pts.len());
+        let mut owner: Vec<usize> = Vec::new();
+        for (i, p) in pts.iter().enumerate() {
+            let hd = cdt
+                .insert(Point2::new(p.x, p.y))
+                .map_err(|e| ChordError(format!("triangulation at ({}, {}): {e:?}", p.x, p.y)))?;
+            if owner.len() <= hd.index() {
+                owner.resize(hd.index() + 1, usize::MAX);
+            }
+            if owner[hd.index()] != usize::MAX {
+                return Err(ChordError(format!(
+                    "two boundary samples coincide at ({}, {})",
+                    p.x, p.y
+                )));
+            }
+            owner[hd.index()] = i;
+            handles.push(hd);
+        }
+        for r in 0..ring_start.len() - 1 {
+            let (s, e) = (ring_start[r], ring_start[r + 1]);
+            for i in s..e {
+                let j = if i + 1 == e { s } else { i + 1 };
+                if !cdt.can_add_constraint(handles[i], handles[j]) {
+                    return Err(ChordError(format!(
+                        "boundary edge at ({}, {}) crosses another ring",
+                        pts[i].x, pts[i].y
+                    )));
+                }
+                cdt.add_constraint(handles[i], handles[j]);
+            }
+        }
+        // parity flood from the outer face: crossing a constraint edge flips inside/outside
+        let nf = cdt.num_all_faces();
+        let mut inside: Vec<Option<bool>> = vec![None; nf];
+        let mut queue = VecDeque::new();
+        for h in cdt.convex_hull() {
+            let c = cdt.is_constraint_edge(h.as_undirected().fix());
+            for f in [h.face(), h.rev().face()] {
+                if f.as_inner().is_some() && inside[f.fix().index()].is_none() {
+                    inside[f.fix().index()] = Some(c);
+                    queue.push_back(f.fix());
+                }
+            }
+        }
+        while let Some(f) = queue.pop_front() {
+            let here = inside[f.index()].unwrap_or(false);
+            let Some(inner) = cdt.face(f).as_inner() else {
+                continue;
+            };
+            for e in inner.adjacent_edges() {
+                let g = e.rev().face();
+                if g.as_inner().is_none() || inside[g.fix().index()].is_some() {
+                    continue;
+                }
+                let c = cdt.is_constraint_edge(e.as_undirected().fix());
+                inside[g.fix().index()] = Some(here ^ c);
+                queue.push_back(g.fix());
+            }
+        }
+        let mut id_of = vec![usize::MAX; nf];
+        let mut tris = Vec::new();
+        for f in cdt.inner_faces() {
+            if inside[f.fix().index()] == Some(true) {
+                id_of[f.fix().index()] = tris.len();
+                let v = f.vertices();
+                tris.push([
+                    owner[v[0].fix().index()],
+                    owner[v[1].fix().index()],
+                    owner[v[2].fix().index()],
+                ]);
+            }
+        }
+        let mut nbr = vec![[None; 3]; tris.len()];
+        for f in cdt.inner_faces() {
+            let t = id_of[f.fix().index()];
+            if t == usize::MAX {
+                continue;
+            }
+            for e in f.adjacent_edges() {
+                if cdt.is_constraint_edge(e.as_undirected().fix()) {
+                    continue;
+                }
+                let [a, _] = e.vertices();
+                let a = owner[a.fix().index()];
+                let k = (0..3).find(|&k| tris[t][k] == a).unwrap_or(0);
+                let g = id_of[e.rev().face().fix().index()];
+                if g != usize::MAX {
+                    nbr[t][k] = Some(g);
+                }
+            }
+        }
+        Ok(Self {
+            pts,
+            ring,
+            ring_start,
+            arc,
+            ring_len,
+            tris,
+            nbr,
+            spacing,
+        })
+    }
+
+    fn next_on_ring(&self, i: usize, steps: usize) -> usize {
+        let r = self.ring[i];
+        let (s, e) = (self.ring_start[r], self.ring_start[r + 1]);
+        s + (i - s + steps) % (e - s)
+    }
+
+    fn prev_on_ring(&self, i: usize, steps: usize) -> usize {
+        let r = self.ring[i];
+        let (s, e) = (self.ring_start[r], self.ring_start[r + 1]);
+        let n = e - s;
+        s + (i - s + n - steps % n) % n
+    }
+
+    /// The two new angles at sample `i` of a chord going to `target`, with the boundary
+    /// direction taken over a stretch of ≈ `reach` on each side (smooths sampling noise).
+    fn end_angles(&self, i: usize, target: DVec2, reach: f64) -> (f64, f64) {
+        let r = self.ring[i];
+        let n = self.ring_start[r + 1] - self.ring_start[r];
+        let steps = ((reach / self.spacing).round() as usize).clamp(1, (n / 4).max(1));
+        let next = self.pts[self.next_on_ring(i, steps)];
+        let prev = self.pts[self.prev_on_ring(i, steps)];
+        let cur = self.pts[i];
+        (left_angle(target, cur, next), left_angle(prev, cur, target))
+    }
+
+    /// `(min angle, ḡ)` of chord `(a, b)`.
+    fn chord_angles(&self, a: usize, b: usize) -> (f64, f64) {
+        let w = self.pts[a].distance(self.pts[b]);
+        let reach = (0.5 * w).max(self.spacing);
+        let (a1, a2) = self.end_angles(a, self.pts[b], reach);
+        let (b1, b2) = self.end_angles(b, self.pts[a], reach);
+        let m = a1.min(a2).min(b1).min(b2);
+        let g = 0.25
+            * (angle_penalty(a1) + angle_penalty(a2) + angle_penalty(b1) + angle_penalty(b2));
+        (m, g)
+    }
+
+    /// All chords (interior edges), each once, as `(a, b)` with `a < b`, sorted.
+    fn chords(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for (t, tri) in self.tris.iter().enumerate() {
+            for k in 0..3 {
+                if let Some(u) = self.nbr[t][k] {
+                    if t < u {
+                        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                        out.push((a.min(b), a.max(b)));
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    fn tri_area(&self, t: usize) -> f64 {
+        let [a, b, c] = self.tris[t];
+        0.5 * (self.pts[b] - self.pts[a])
+            .perp_dot(self.pts[c] - self.pts[a])
+            .abs()
+    }
+}
+
+/// The layout cuts of a region, in the order they must be applied (bridges from the outer
+/// ring outwards, closing chords, transverse cuts), as point pairs on the boundary.
+pub(crate) fn layout_cuts(
+    region: &Region,
+    spacing: f64,
+    aspect: f64,
+    min_area: f64,
+) -> Result<Vec<(DVec2, DVec2)>, ChordError> {
+    let m = ChordMesh::new(region, spacing)?;
+    let min_angle = MIN_END_ANGLE_DEG.to_radians();
+    let mut cut_set: HashSet<(usize, usize)> = HashSet::new();
+    let mut order: Vec<(usize, usize)> = Vec::new();
+    let mut ends: Vec<usize> = Vec::new();
+
+    // 1. hole bridges
+    let nr = m.ring_start.len() - 1;
+    if nr > 1 {
+        let mut inter: Vec<(f64, usize, usize)> = Vec::new();
+        let mut angle_of: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+        for (a, b) in m.chords() {
+            if m.ring[a] == m.ring[b] {
+                continue;
+            }
+            let (amin, g) = m.chord_angles(a, b);
+            angle_of.insert((a, b), amin);
+            let cost = m.pts[a].distance(m.pts[b]) * (1.0 + g);
+            inter.push((cost, a, b));
+        }
+        let bridge_angle = min_angle.min(PI / 6.0);
+        inter.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        // Kruskal
+        let mut parent: Vec<usize> = (0..nr).collect();
+        fn find(p: &mut [usize], x: usize) -> usize {
+            let mut x = x;
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        let mut tree: Vec<(usize, usize)> = Vec::new();
+        let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nr]; // (ring, tree edge id)
+        let mut used = vec![false; inter.len()];
+        for (k, &(_, a, b)) in inter.iter().enumerate() {
+            let (ra, rb) = (m.ring[a], m.ring[b]);
+            let (x, y) = (find(&mut parent, ra), find(&mut parent, rb));
+            if x == y || angle_of.get(&(a, b)).copied().unwrap_or(0.0) < bridge_angle {
+                continue;
+            }
+            if ends.iter().any(|&e| e == a || e == b) {
+                continue;
+            }
+            parent[x] = y;
+            adj[ra].push((rb, tree.len()));
+            adj[rb].push((ra, tree.len()));
+            tree.push((a, b));
+            ends.extend([a, b]);
+            used[k] = true;
+        }
+        if tree.len() != nr - 1 {
+            return Err(ChordError(format!(
+                "the rings are not connected by admissible chords ({} of {} bridges)",
+                tree.len(),
+                nr - 1
+            )));
+        }
+        // BFS order from the outer ring; parent edge of each ring
+        let mut depth = vec![usize::MAX; nr];
+        let mut up: Vec<Option<(usize, usize)>> = vec![None; nr]; // (parent ring, edge)
+        depth[0] = 0;
+        let mut q = VecDeque::from([0usize]);
+        let mut bfs_edges = Vec::new();
+        while let Some(r) = q.pop_front() {
+            let mut next = adj[r].clone();
+            next.sort_unstable();
+            for (s, e) in next {
+                if depth[s] == usize::MAX {
+                    depth[s] = depth[r] + 1;
+                    up[s] = Some((r, e));
+                    bfs_edges.push(e);
+                    q.push_back(s);
+                }
+            }
+        }
+        for &e in &bfs_edges {
+            order.push(tree[e]);
+        }
+        // closing chords: cover every tree edge by a cycle
+        let mut covered = vec![false; tree.len()];
+        let path = |mut x: usize, mut y: usize| -> Vec<usize> {
+            let mut p = Vec::new();
+            while x != y {
+                if depth[x] >= depth[y] {
+                    let (px, e) = up[x].unwrap_or((x, usize::MAX));
+                    p.push(e);
+                    x = px;
+                } else {
+                    let (py, e) = up[y].unwrap_or((y, usize::MAX));
+                    p.push(e);
+                    y = py;
+                }
+                if p.len() > nr {
+                    break;
+                }
+            }
+            p
+        };
+        // strict pass, then a relaxed one: (smallest end angle, spacing to other ends as a
+        // fraction of the chord length, smallest hole arc)
+        for (angle, near_frac, arc_min) in [
+            (bridge_angle, 0.5, MIN_HOLE_ARC),
+            (0.5 * bridge_angle, 0.0, 0.4 * MIN_HOLE_ARC),
+        ] {
+            for (k, &(_, a, b)) in inter.iter().enumerate() {
+                if covered.iter().all(|&c| c) {
+                    break;
+                }
+                if used[k] || angle_of.get(&(a, b)).copied().unwrap_or(0.0) < angle {
+                    continue;
+                }
+                let (ra, rb) = (m.ring[a], m.ring[b]);
+                let p = path(ra, rb);
+                if p.iter().all(|&e| e == usize::MAX || covered[e]) {
+                    continue;
+                }
+                let d = m.spacing.max(near_frac * m.pts[a].distance(m.pts[b]));
+                let near = |x: usize| ends.iter().any(|&e| m.pts[e].distance(m.pts[x]) <= d);
+                if near(a) || near(b) {
+                    continue;
+                }
+                // a second chord of a bridged ring pair must split the hole's perimeter
+                if p.len() == 1 {
+                    let (ta, tb) = tree[p[0]];
+                    let hole_r = if ra == 0 { rb } else { ra.max(rb) };
+                    let h_new = if m.ring[a] == hole_r { a } else { b };
+                    let h_old = if m.ring[ta] == hole_r { ta } else { tb };
+                    let d = (m.arc[h_new] - m.arc[h_old]).abs();
+                    let l = m.ring_len[hole_r];
+                    if d.min(l - d) < arc_min * l {
+                        continue;
+                    }
+                }
+                for &e in &p {
+                    if e != usize::MAX {
+                        covered[e] = true;
+                    }
+                }
+                used[k] = true;
+                order.push((a, b));
+                ends.extend([a, b]);
+            }
+        }
+        // a bridge on no cycle would leave one block on both of its sides: drop it with the
+        // rings hanging from it (Algorithm 2 removes those holes later)
+        let mut detached = vec![false; nr];
+        for r in 1..nr {
+            let mut x = r;
+            while let Some((px, e)) = up[x] {
+                if !covered[e] {
+                    detached[r] = true;
+                    break;
+                }
+                x = px;
+            }
+        }
+        order.retain(|&(a, b)| !detached[m.ring[a]] && !detached[m.ring[b]]);
+        for &(a, b) in &order {
+            cut_set.insert((a.min(b), a.max(b)));
+        }
+    }
+
+    // 2. transverse cuts in the simply connected pieces
+    let nt = m.tris.len();
+    let open = |t: usize, k: usize, cut_set: &HashSet<(usize, usize)>| -> Option<usize> {
+        let u = m.nbr[t][k]?;
+        let (a, b) = (m.tris[t][k], m.tris[t][(k + 1) % 3]);
+        if cut_set.contains(&(a.min(b), a.max(b))) {
+            None
+        } else {
+            Some(u)
+        }
+    };
+    let mut comp = vec![usize::MAX; nt];
+    let mut work: Vec<usize> = Vec::new(); // a seed triangle per piece
+    for t in 0..nt {
+        if comp[t] == usize::MAX {
+            work.push(t);
+            let mut st = vec![t];
+            comp[t] = t;
+            while let Some(x) = st.pop() {
+                for k in 0..3 {
+                    if let Some(u) = open(x, k, &cut_set) {
+                        if comp[u] == usize::MAX {
+                            comp[u] = t;
+                            st.push(u);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let budget = 4 * nt + 16;
+    let mut steps = 0;
+    while let Some(seed) = work.pop() {
+        steps += 1;
+        if steps > budget {
+            break;
+        }
+        // DFS tree of the piece
+        let mut parent: BTreeMap<usize, (usize, usize)> = BTreeMap::new(); // tri → (parent, k)
+        let mut seen: HashSet<usize> = HashSet::from([seed]);
+        let mut dfs = vec![seed];
+        let mut order_t = Vec::new();
+        let mut dual_edges = 0usize;
+        while let Some(x) = dfs.pop() {
+            order_t.push(x);
+            for k in 0..3 {
+                if let Some(u) = open(x, k, &cut_set) {
+                    dual_edges += 1;
+                    if seen.insert(u) {
+                        parent.insert(u, (x, k));
+                        dfs.push(u);
+                    }
+                }
+            }
+        }
+        if dual_edges / 2 + 1 != order_t.len() {
+            continue; // not simply connected (should not happen): leave it to Algorithm 1
+        }
+        let mut sub: BTreeMap<usize, f64> = BTreeMap::new();
+        for &x in order_t.iter().rev() {
+            let s = m.tri_area(x) + sub.get(&x).copied().unwrap_or(0.0);
+            sub.insert(x, s);
+            if let Some(&(p, _)) = parent.get(&x) {
+                *sub.entry(p).or_insert(0.0) += s;
+            }
+        }
+        let total = sub.get(&seed).copied().unwrap_or(0.0);
+        let mut best: Option<(f64, usize, usize, usize)> = None;
+        for &x in &order_t {
+            let Some(&(p, k)) = parent.get(&x) else {
+                continue;
+            };
+            let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
+            let a1 = sub.get(&x).copied().unwrap_or(0.0);
+            let small = a1.min(total - a1);
+            if small < min_area {
+                continue;
+            }
+            let w = m.pts[a].distance(m.pts[b]);
+            let raw = small / (w * w);
+            if raw < aspect {
+                continue;
+            }
+            let (amin, g) = m.chord_angles(a, b);
+            if amin < min_angle {
+                continue;
+            }
+            let score = raw * (1.0 - 0.5 * g.min(1.0));
+            if score < aspect {
+                continue;
+            }
+            let d = m.spacing.max(0.5 * w);
+            if ends
+                .iter()
+                .any(|&e| m.pts[e].distance(m.pts[a]) <= d || m.pts[e].distance(m.pts[b]) <= d)
+            {
+                continue;
+            }
+            let better = match best {
+                None => true,
+                Some((s, ba, bb, _)) => score > s || (score == s && (a, b) < (ba, bb)),
+            };
+            if better {
+                best = Some((score, a, b, x));
+            }
+        }
+        if let Some((_, a, b, x)) = best {
+            cut_set.insert((a.min(b), a.max(b)));
+            order.push((a, b));
+            ends.extend([a, b]);
+            work.push(seed);
+            work.push(x);
+        }
+    }
+    Ok(order
+        .into_iter()
+        .map(|(a, b)| (m.pts[a], m.pts[b]))
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rect(w: f64, h: f64) -> Region {
+        Region::new(
+            vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(w, 0.0),
+                DVec2::new(w, h),
+                DVec2::new(0.0, h),
+            ],
+            vec![],
+        )
+        .expect("rectangle")
+    }
+
+    #[test]
+    fn the_inside_triangles_cover_the_region() {
+        let r = Region::new(
+            vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(4.0, 0.0),
+                DVec2::new(4.0, 4.0),
+                DVec2::new(0.0, 4.0),
+            ],
+            vec![vec![
+                DVec2::new(1.0, 1.0),
+                DVec2::new(1.0, 3.0),
+                DVec2::new(3.0, 3.0),
+                DVec2::new(3.0, 1.0),
+            ]],
+        )
+        .expect("square with a hole");
+        let m = ChordMesh::new(&r, 0.5).expect("triangulation");
+        let a: f64 = (0..m.tris.len()).map(|t| m.tri_area(t)).sum();
+        assert!((a - 12.0).abs() < 1e-9, "area {a}");
+    }
+
+    #[test]
+    fn a_square_gets_no_transverse_cut() {
+        let cuts = layout_cuts(&rect(1.0, 1.0), 0.05, DEFAULT_ASPECT, 0.0).expect("cuts");
+        assert!(cuts.is_empty(), "{cuts:?}");
+    }
+
+    #[test]
+    fn a_long_strip_is_cut_across_into_short_blocks() {
+        // 10 × 1: every cut is vertical (perpendicular to the axis); the pieces are at most
+        // 2T = 3 widths long, so at least 10/3 → 3 cuts
+        let cuts = layout_cuts(&rect(10.0, 1.0), 0.1, DEFAULT_ASPECT, 0.0).expect("cuts");
+        assert!(cuts.len() >= 3, "{cuts:?}");
+        let mut xs: Vec<f64> = cuts
+            .iter()
+            .map(|(a, b)| {
+                assert!((a.x - b.x).abs() < 1e-9, "cut not transverse: {a:?} {b:?}");
+                a.x
+            })
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        let mut prev = 0.0;
+        for x in xs.iter().chain(std::iter::once(&10.0)) {
+            assert!(x - prev <= 3.0 + 1e-9, "piece {prev}..{x} longer than 3 widths");
+            prev = *x;
+        }
+    }
+
+    #[test]
+    fn a_hole_gets_two_bridges_that_split_it() {
+        let r = Region::new(
+            vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(4.0, 0.0),
+                DVec2::new(4.0, 4.0),
+                DVec2::new(0.0, 4.0),
+            ],
+            vec![vec![
+                DVec2::new(1.0, 1.0),
+                DVec2::new(1.0, 3.0),
+                DVec2::new(3.0, 3.0),
+                DVec2::new(3.0, 1.0),
+            ]],
+        )
+        .expect("square with a hole");
+        let cuts = layout_cuts(&r, 0.25, DEFAULT_ASPECT, 0.0).expect("cuts");
+        assert!(cuts.len() >= 2, "{cuts:?}");
+        // the first two are the bridge and its closing chord, each 1 long (the gap)
+        for (a, b) in &cuts[..2] {
+            assert!((a.distance(*b) - 1.0).abs() < 1e-9, "{a:?} {b:?}");
+        }
+    }
+}
