@@ -91,6 +91,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod error;
+pub mod fit;
 pub mod fixtures;
 pub mod interval;
 mod lp;
@@ -102,6 +103,7 @@ pub mod verify;
 pub mod vertex;
 
 pub use error::{BoundInfo, CompatError, ConflictItem, InfeasibilityReport};
+pub use fit::{deviation_cost, solve_fit, FitOptions, FitTargets};
 pub use interval::{
     assign_intervals, Direction, IntervalEdge, IntervalOptions, IntervalProblem, IntervalSolution,
     IntervalVerification,

@@ -417,7 +417,7 @@ fn side_row_of_curves(inst: &Instance<'_>) -> Vec<Option<(usize, i64)>> {
     out
 }
 
-const INF_CAP: i64 = i64::MAX / 4;
+pub(crate) const INF_CAP: i64 = i64::MAX / 4;
 
 #[derive(Debug, Clone, Copy)]
 struct Edge {
@@ -427,13 +427,13 @@ struct Edge {
 }
 
 /// Residual network for successive shortest paths.
-struct Network {
+pub(crate) struct Network {
     edges: Vec<Edge>,
     adj: Vec<Vec<usize>>,
 }
 
 impl Network {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         Network {
             edges: Vec::new(),
             adj: vec![Vec::new(); n],
@@ -441,7 +441,7 @@ impl Network {
     }
 
     /// Add `u→v` and its reverse; returns the forward edge index (reverse = index ^ 1).
-    fn add_edge(&mut self, u: usize, v: usize, cap: i64, cost: i64) -> usize {
+    pub(crate) fn add_edge(&mut self, u: usize, v: usize, cap: i64, cost: i64) -> usize {
         let e = self.edges.len();
         self.edges.push(Edge { to: v, cap, cost });
         self.edges.push(Edge {
@@ -454,7 +454,7 @@ impl Network {
         e
     }
 
-    fn flow(&self, e: usize) -> i64 {
+    pub(crate) fn flow(&self, e: usize) -> i64 {
         self.edges[e ^ 1].cap
     }
 
@@ -514,7 +514,7 @@ impl Network {
     /// Primal–dual min-cost flow: Dijkstra with potentials (all initial costs ≥ 0) to find the shortest
     /// distances, then blocking flows on the zero-reduced-cost arcs, repeated until `limit` is sent or the
     /// sink is unreachable. Returns the flow sent and the final potentials.
-    fn min_cost_flow(&mut self, s: usize, t: usize, limit: i64) -> (i64, Vec<i64>) {
+    pub(crate) fn min_cost_flow(&mut self, s: usize, t: usize, limit: i64) -> (i64, Vec<i64>) {
         let n = self.adj.len();
         let mut pot = vec![0i64; n];
         let mut dist = vec![i64::MAX; n];

@@ -88,6 +88,10 @@ pub enum SolverPath {
     NetworkFlow,
     /// LP relaxation of the reduced form, rounding, and a greedy repair on single-row columns.
     LpRoundRepair(MilpBackend),
+    /// Target fit ([`crate::solve_fit`]) as a convex-cost min-cost circulation (exact, certified).
+    FitNetwork,
+    /// Target fit as a MILP with piecewise-linear epigraph rows (systems that are not networks).
+    FitMilp(MilpBackend),
 }
 
 impl std::fmt::Display for SolverPath {
@@ -97,6 +101,8 @@ impl std::fmt::Display for SolverPath {
             SolverPath::ReducedMilp(b) => write!(f, "reduced MILP ({b})"),
             SolverPath::NetworkFlow => write!(f, "network flow (exact)"),
             SolverPath::LpRoundRepair(b) => write!(f, "LP relaxation + rounding + repair ({b})"),
+            SolverPath::FitNetwork => write!(f, "target fit, convex-cost network flow (exact)"),
+            SolverPath::FitMilp(b) => write!(f, "target fit MILP ({b})"),
         }
     }
 }
@@ -248,6 +254,9 @@ pub fn solve(
                 Ok(None) => Ok(None),
                 Err(e) => Err(e),
             },
+            SolverPath::FitNetwork | SolverPath::FitMilp(_) => {
+                Err("the target fit is not a path of problem (5.10)".into())
+            }
         };
         match raw {
             Ok(Some((counts, integral))) => {
@@ -298,6 +307,28 @@ pub fn solve(
         }
     }
     Err(CompatError::SolverFailed { attempts: rejected })
+}
+
+/// The infeasibility report of the system with lower bounds `lower` (one per curve, pins from the
+/// problem): the deletion filter of [`solve()`], for other objectives over the same constraints.
+pub(crate) fn infeasibility(
+    problem: &CompatProblem,
+    system: &CompatSystem,
+    lower: &[i64],
+    time_limit: Option<f64>,
+) -> CompatError {
+    let prep = Prepared {
+        problem,
+        system,
+        lower: lower.to_vec(),
+        pins: problem
+            .curves
+            .iter()
+            .map(|c| c.pinned.map(|p| p as i64))
+            .collect(),
+        time_limit,
+    };
+    infeasible(&prep, &SolveOptions::default())
 }
 
 /// Convert raw values to integers, reporting integrality.

@@ -21,6 +21,13 @@ pub enum Optimality {
         /// Proven lower bound on the optimum.
         dual_bound: i128,
     },
+    /// The target fit ([`crate::solve_fit`]): row duals `y` were checked to make every class value a
+    /// minimiser of its convex cost minus `λ_c x` (the reduced-cost certificate of `fit.rs`), so the
+    /// counts minimise the fit's objective.
+    FitCertified {
+        /// The optimal fit cost `Σ w_j c(m_j; t_j)` (pinned curves excluded).
+        cost: i128,
+    },
     /// No certificate is available (the system is not a network matrix after re-signing rows); the
     /// solver's own optimality claim is all there is.
     NotCertified {

@@ -34,6 +34,7 @@
 
 pub mod bspline_maps;
 pub mod corners;
+pub mod curves;
 pub mod flat_corners;
 pub mod hex;
 pub mod pde;

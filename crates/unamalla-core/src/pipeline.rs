@@ -51,15 +51,12 @@
 use std::time::Instant;
 
 use serde::Serialize;
-use unamalla_compat_ilp::{self as ilp, CompatProblem};
+use unamalla_compat_ilp as ilp;
 use unamalla_contour::{remove_features_below, simplify_region, SimplifyOptions};
 use unamalla_decompose::submap::{prefers_submap, submap, SubmapOptions, Submapping};
-use unamalla_decompose::{decompose, DecomposeOptions, Decomposition, EdgeKind};
+use unamalla_decompose::{decompose, DecomposeOptions, Decomposition};
 use unamalla_mesh::quality::QualityReport;
-use unamalla_mesh::resample::{polyline_length, resample_arc_length};
-use unamalla_mesh::{
-    tfi2, BlockMesh2, DVec2, HasNodes, HasQuadCells, Region, StructuredGrid2, TfiParams,
-};
+use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells, Region};
 use unamalla_optim::monitor::{Control, Monitor, NullObserver, Observer};
 use unamalla_optim::{smooth, SmoothOptions};
 
@@ -473,21 +470,7 @@ impl Mesher {
 
                 // 3. compatible counts
                 self.stage(Stage::Counts, "solving for compatible point counts");
-                let curves = BlockCurves::new(&decomposition);
-                let problem = curves.problem();
-                let bounds = match self.size {
-                    MeshSize::Cells(n) => {
-                        let n = n.max(1) as f64;
-                        ilp::LowerBounds::CellSize((simplified.area() / n).sqrt())
-                    }
-                    MeshSize::CellSize(h) => ilp::LowerBounds::CellSize(h),
-                    MeshSize::Density(d) => ilp::LowerBounds::Density(d.max(1)),
-                };
-                let solve_opts = ilp::SolveOptions {
-                    bounds,
-                    ..ilp::SolveOptions::default()
-                };
-                let counts = ilp::solve(&problem, &solve_opts)?;
+                let (curves, counts) = crate::curves::compatible_counts(&decomposition, self.size)?;
                 lap(Stage::Counts, &mut timer);
 
                 // 4–5. reparametrize + TFI
@@ -718,137 +701,4 @@ fn boundary_hausdorff(mesh: &BlockMesh2, region: &Region) -> f64 {
         worst = worst.max(unamalla_contour::hausdorff(&pts, target));
     }
     worst
-}
-
-/// The curves Q_j of every block side, numbered block by block and side by side (the J_{k,side}
-/// convention of seed 000 §5.2.1), with the cut pairs.
-struct BlockCurves {
-    /// For each block and side, the curve ids.
-    sides: Vec<[Vec<usize>; 4]>,
-    /// Curve polylines in block-CCW order.
-    points: Vec<Vec<DVec2>>,
-    /// For cut curves: (cut id, whether the polyline runs from cut.a to cut.b).
-    cut_of: Vec<Option<(usize, bool)>>,
-}
-
-impl BlockCurves {
-    fn new(d: &Decomposition) -> Self {
-        let mut sides = Vec::with_capacity(d.blocks.len());
-        let mut points = Vec::new();
-        let mut cut_of = Vec::new();
-        for b in &d.blocks {
-            let sc = b.side_curves();
-            let mut ids: [Vec<usize>; 4] = Default::default();
-            for (s, curves) in sc.iter().enumerate() {
-                for c in curves {
-                    ids[s].push(points.len());
-                    let cut = match c.kind {
-                        EdgeKind::Cut { cut, .. } => {
-                            let a = d.cuts[cut].a;
-                            let forward =
-                                c.points[0].distance(a) <= c.points[c.points.len() - 1].distance(a);
-                            Some((cut, forward))
-                        }
-                        EdgeKind::Boundary { .. } => None,
-                    };
-                    points.push(c.points.clone());
-                    cut_of.push(cut);
-                }
-            }
-            sides.push(ids);
-        }
-        Self {
-            sides,
-            points,
-            cut_of,
-        }
-    }
-
-    fn problem(&self) -> CompatProblem {
-        let curves = self
-            .points
-            .iter()
-            .enumerate()
-            .map(|(j, p)| ilp::Curve::new(j, polyline_length(p)))
-            .collect();
-        let blocks = self
-            .sides
-            .iter()
-            .enumerate()
-            .map(|(k, s)| {
-                ilp::Block::new(k, s[0].clone(), s[1].clone(), s[2].clone(), s[3].clone())
-            })
-            .collect();
-        let mut first: std::collections::HashMap<usize, usize> = Default::default();
-        let mut cuts = Vec::new();
-        for (j, c) in self.cut_of.iter().enumerate() {
-            if let Some((cut, _)) = c {
-                if let Some(&i) = first.get(cut) {
-                    cuts.push(ilp::CutPair::new(i, j));
-                } else {
-                    first.insert(*cut, j);
-                }
-            }
-        }
-        CompatProblem::new(curves, blocks, cuts)
-    }
-
-    /// Resamples every curve with its count (cuts once, shared by both copies) and fills every
-    /// block by TFI.
-    fn grids(
-        &self,
-        d: &Decomposition,
-        counts: &[usize],
-    ) -> Result<Vec<StructuredGrid2>, CoreError> {
-        let mut cut_pts: std::collections::HashMap<usize, Vec<DVec2>> = Default::default();
-        let mut sampled: Vec<Vec<DVec2>> = Vec::with_capacity(self.points.len());
-        for (j, p) in self.points.iter().enumerate() {
-            let m = counts[j];
-            let pts = match self.cut_of[j] {
-                Some((cut, forward)) => {
-                    let canon = cut_pts.entry(cut).or_insert_with(|| {
-                        let c = &d.cuts[cut];
-                        resample_arc_length(&[c.a, c.b], m).unwrap_or_else(|_| vec![c.a, c.b])
-                    });
-                    let mut v = canon.clone();
-                    if !forward {
-                        v.reverse();
-                    }
-                    // endpoints exactly as the block ring has them
-                    if let (Some(f), Some(l)) = (v.first_mut(), p.first()) {
-                        *f = *l;
-                    }
-                    if let (Some(f), Some(l)) = (v.last_mut(), p.last()) {
-                        *f = *l;
-                    }
-                    v
-                }
-                None => resample_arc_length(p, m)?,
-            };
-            sampled.push(pts);
-        }
-        let mut grids = Vec::with_capacity(self.sides.len());
-        for sides in &self.sides {
-            let side = |s: usize| -> Vec<DVec2> {
-                let mut out: Vec<DVec2> = Vec::new();
-                for &j in &sides[s] {
-                    let pts = &sampled[j];
-                    if out.is_empty() {
-                        out.extend_from_slice(pts);
-                    } else {
-                        out.extend_from_slice(&pts[1..]);
-                    }
-                }
-                out
-            };
-            let bottom = side(0);
-            let right = side(1);
-            let mut top = side(2);
-            top.reverse();
-            let mut left = side(3);
-            left.reverse();
-            grids.push(tfi2(&bottom, &right, &top, &left, TfiParams::ArcLength)?);
-        }
-        Ok(grids)
-    }
 }
