@@ -10,24 +10,27 @@ use unamalla_core::decompose::{DecomposeOptions, Layout};
 use unamalla_core::pipeline::Mesher;
 
 fn main() {
-    let mut layout = Layout::default();
+    let mut layout: Option<Layout> = None;
     let mut aspect = unamalla_core::decompose::chords::DEFAULT_ASPECT;
     let mut cells = 20_000usize;
     let mut budget = 15.0f64;
     let mut paths = Vec::new();
+    let mut predict_only = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut val = || args.next().unwrap_or_default();
         match a.as_str() {
             "--layout" => {
                 layout = match val().as_str() {
-                    "concavity" => Layout::Concavity,
-                    _ => Layout::Chords,
+                    "concavity" => Some(Layout::Concavity),
+                    "chords" => Some(Layout::Chords),
+                    _ => None,
                 }
             }
             "--aspect" => aspect = val().parse().unwrap_or(aspect),
             "--cells" => cells = val().parse().unwrap_or(cells),
             "--budget" => budget = val().parse().unwrap_or(budget),
+            "--predict-only" => predict_only = true,
             _ => paths.push(a),
         }
     }
@@ -44,16 +47,45 @@ fn main() {
             }
         };
         let opts = DecomposeOptions {
-            layout,
             chord_aspect: aspect,
             ..DecomposeOptions::default()
         };
         let t = std::time::Instant::now();
-        let r = Mesher::new()
+        if predict_only {
+            let mesher = Mesher::new().cells(cells).decompose_options(opts.clone());
+            let Ok(prep) = mesher.prepare_region(&region) else {
+                continue;
+            };
+            let r = &prep.mesh_region;
+            let h = (r.area() / cells as f64).sqrt();
+            let o = DecomposeOptions {
+                cell_size: Some(h),
+                ..opts
+            };
+            match unamalla_core::pipeline::choose_layout(
+                r,
+                &o,
+                unamalla_core::pipeline::MeshSize::Cells(cells),
+            ) {
+                Ok((d, c)) => println!(
+                    "{{\"region\":\"{name}\",\"layout\":\"{}\",\"blocks\":{},\"cands\":\"{:?}\",\"seconds\":{:.2}}}",
+                    c.layout,
+                    d.blocks.len(),
+                    c.candidates,
+                    t.elapsed().as_secs_f64()
+                ),
+                Err(e) => println!("{{\"region\":\"{name}\",\"error\":\"{e}\"}}"),
+            }
+            continue;
+        }
+        let mut mesher = Mesher::new()
             .cells(cells)
             .smooth_budget(budget)
-            .decompose_options(opts)
-            .mesh(&region);
+            .decompose_options(opts);
+        if let Some(l) = layout {
+            mesher = mesher.layout(l);
+        }
+        let r = mesher.mesh(&region);
         match r {
             Ok(r) => {
                 let rep = &r.report;
@@ -71,8 +103,18 @@ fn main() {
                     .iter()
                     .map(|(s, t)| format!("\"{s:?}\":{t:.2}"))
                     .collect();
+                let (pred, cands) = match &rep.layout {
+                    Some(c) => (c.predicted_percent, format!("{:?}", c.candidates)),
+                    None => (f64::NAN, String::new()),
+                };
+                let corr = correlation(
+                    &rep.block_quality
+                        .iter()
+                        .map(|b| (b.predicted, b.achieved, b.cells as f64))
+                        .collect::<Vec<_>>(),
+                );
                 println!(
-                    "{{\"region\":\"{name}\",\"chords\":{chords},\"blocks\":{},\"cells\":{},\"mu\":{:.2},\"nonconvex\":{},\"sing\":{},\"smoothing\":\"{}\",\"seconds\":{:.2},\"stages\":{{{}}}}}",
+                    "{{\"region\":\"{name}\",\"pred\":{pred:.2},\"corr\":{corr:.3},\"cands\":\"{cands}\",\"chords\":{chords},\"blocks\":{},\"cells\":{},\"mu\":{:.2},\"nonconvex\":{},\"sing\":{},\"smoothing\":\"{}\",\"seconds\":{:.2},\"stages\":{{{}}}}}",
                     rep.blocks,
                     rep.cells,
                     rep.mu_ge_0_8_percent,
@@ -83,7 +125,27 @@ fn main() {
                     st.join(",")
                 );
             }
-            Err(e) => println!("{{\"region\":\"{name}\",\"error\":\"{}\"}}", e.to_string().replace('"', "'")),
+            Err(e) => println!(
+                "{{\"region\":\"{name}\",\"error\":\"{}\"}}",
+                e.to_string().replace('"', "'")
+            ),
         }
     }
+}
+
+/// Cell-weighted Pearson correlation of (predicted, achieved) per block.
+fn correlation(v: &[(f64, f64, f64)]) -> f64 {
+    let w: f64 = v.iter().map(|x| x.2).sum();
+    if v.len() < 3 || w <= 0.0 {
+        return f64::NAN;
+    }
+    let mx = v.iter().map(|x| x.0 * x.2).sum::<f64>() / w;
+    let my = v.iter().map(|x| x.1 * x.2).sum::<f64>() / w;
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for &(x, y, c) in v {
+        sxy += c * (x - mx) * (y - my);
+        sxx += c * (x - mx) * (x - mx);
+        syy += c * (y - my) * (y - my);
+    }
+    sxy / (sxx * syy).sqrt()
 }

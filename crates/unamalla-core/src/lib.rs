@@ -39,6 +39,7 @@ pub mod flat_corners;
 pub mod hex;
 pub mod pde;
 pub mod pipeline;
+pub mod predict;
 pub mod render;
 pub mod single_block;
 pub mod untangle;

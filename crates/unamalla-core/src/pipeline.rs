@@ -54,7 +54,7 @@ use serde::Serialize;
 use unamalla_compat_ilp as ilp;
 use unamalla_contour::{remove_features_below, simplify_region, SimplifyOptions};
 use unamalla_decompose::submap::{prefers_submap, submap, SubmapOptions, Submapping};
-use unamalla_decompose::{decompose, DecomposeOptions, Decomposition};
+use unamalla_decompose::{chord_layout, decompose, DecomposeOptions, Decomposition, Layout};
 use unamalla_mesh::quality::QualityReport;
 use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells, Region};
 use unamalla_optim::monitor::{Control, Monitor, NullObserver, Observer};
@@ -144,6 +144,7 @@ pub struct Mesher {
     size: MeshSize,
     simplify: Option<SimplifyOptions>,
     decompose_opts: DecomposeOptions,
+    layout: Option<Layout>,
     decomposition: Option<Decomposition>,
     smooth_opts: SmoothOptions,
     boundary_density: f64,
@@ -219,6 +220,11 @@ pub struct MeshReport {
     pub seconds: f64,
     /// Wall time per stage.
     pub stage_seconds: Vec<(Stage, f64)>,
+    /// The layout chosen by predicted quality (`None` when the layout was given, read from a
+    /// file or made by submapping).
+    pub layout: Option<LayoutChoice>,
+    /// Predicted and achieved μ ≥ 0.8 share per block (empty without a prediction).
+    pub block_quality: Vec<BlockQuality>,
     /// The full quality report of the final mesh.
     pub quality: QualityReport,
 }
@@ -231,6 +237,7 @@ impl Mesher {
             size: MeshSize::default(),
             simplify: Some(SimplifyOptions::default()),
             decompose_opts: DecomposeOptions::default(),
+            layout: None,
             decomposition: None,
             smooth_opts: default_smooth_options(),
             boundary_density: 1.0,
@@ -286,6 +293,14 @@ impl Mesher {
     /// Decomposition options for the automatic decomposition.
     pub fn decompose_options(mut self, opts: DecomposeOptions) -> Self {
         self.decompose_opts = opts;
+        self
+    }
+
+    /// Uses this block layout instead of choosing one by predicted quality (the default:
+    /// both the chord layout and the concavity layout are built and the one with the higher
+    /// predicted μ ≥ 0.8 share is meshed, module [`crate::predict`]).
+    pub fn layout(mut self, layout: Layout) -> Self {
+        self.layout = Some(layout);
         self
     }
     /// Use this decomposition (e.g. loaded from a file) instead of computing one. It must belong
@@ -434,6 +449,7 @@ impl Mesher {
             }
             _ => None,
         };
+        let mut layout_choice: Option<LayoutChoice> = None;
         let (decomposition, counts, mut mesh) = match submapping.as_ref() {
             Some(s) => {
                 lap(Stage::Decompose, &mut timer);
@@ -463,7 +479,17 @@ impl Mesher {
                                 MeshSize::Density(_) => None,
                             };
                         }
-                        decompose(&simplified, &opts)?
+                        match self.layout {
+                            Some(l) => {
+                                opts.layout = l;
+                                decompose(&simplified, &opts)?
+                            }
+                            None => {
+                                let (d, choice) = choose_layout(&simplified, &opts, self.size)?;
+                                layout_choice = Some(choice);
+                                d
+                            }
+                        }
                     }
                 };
                 lap(Stage::Decompose, &mut timer);
@@ -578,6 +604,26 @@ impl Mesher {
             smoothing: smoothing.status.to_string(),
             seconds: t0.elapsed().as_secs_f64(),
             stage_seconds,
+            block_quality: layout_choice
+                .as_ref()
+                .map(|c| {
+                    c.blocks
+                        .iter()
+                        .enumerate()
+                        .filter(|(b, _)| *b < mesh.blocks().len())
+                        .map(|(b, &p)| {
+                            let (a, cells) = crate::predict::block_good_share(&mesh, b);
+                            BlockQuality {
+                                block: b,
+                                cells,
+                                predicted: 100.0 * p,
+                                achieved: 100.0 * a,
+                            }
+                        })
+                        .collect()
+                })
+                .unwrap_or_default(),
+            layout: layout_choice,
             quality,
         };
         Ok(MeshResult {
@@ -701,4 +747,131 @@ fn boundary_hausdorff(mesh: &BlockMesh2, region: &Region) -> f64 {
         worst = worst.max(unamalla_contour::hausdorff(&pts, target));
     }
     worst
+}
+
+/// Margin (share of cells) by which the chord layout's prediction must beat the concavity
+/// layout's to be chosen: the prediction is made on a coarse mesh with a few Laplacian sweeps,
+/// so differences below a percent are not resolved by it (`tests/predictor.rs`).
+pub const LAYOUT_MARGIN: f64 = 0.01;
+
+/// The chord layouts [`choose_layout`] tries: aspect thresholds T of the transverse cuts
+/// (`unamalla_decompose::chords`). Measured with the predictor on the 34 development regions
+/// at 20,000 cells (`layout_eval --predict-only --aspect T`): mean predicted μ ≥ 0.8 share of
+/// the chord layout alone 86.9 % (T = 0.35), 84.0 % (0.75), 82.8 % (1.5), 81.9 % (2), 81.0 %
+/// (3), against 83.0 % for the concavity layout; no single T is best on every region, the best
+/// of the three per region averages 89.4 %.
+pub const LAYOUT_ASPECTS: [(&str, f64); 3] = [
+    ("chords-0.35", 0.35),
+    ("chords-0.75", 0.75),
+    ("chords-1.5", 1.5),
+];
+
+/// Which layout [`Mesher`] chose, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayoutChoice {
+    /// `"concavity"` or `"chords-T"` (T the aspect threshold, [`LAYOUT_ASPECTS`]).
+    pub layout: String,
+    /// Predicted μ ≥ 0.8 percentage of the chosen layout.
+    pub predicted_percent: f64,
+    /// Predicted μ ≥ 0.8 percentage of every candidate (`(layout, percent)`; a candidate that
+    /// could not be built or predicted is absent).
+    pub candidates: Vec<(String, f64)>,
+    /// Predicted μ ≥ 0.8 share per block of the chosen layout.
+    pub blocks: Vec<f64>,
+}
+
+/// Builds the concavity layout and the chord layouts of [`LAYOUT_ASPECTS`] of `region` and
+/// keeps the one with the highest predicted μ ≥ 0.8 share ([`crate::predict::predict_mesh`]; the concavity layout wins ties
+/// within [`LAYOUT_MARGIN`], then the one with fewer blocks).
+pub fn choose_layout(
+    region: &Region,
+    opts: &DecomposeOptions,
+    size: MeshSize,
+) -> Result<(Decomposition, LayoutChoice), CoreError> {
+    let mut cands: Vec<(&str, Decomposition)> = Vec::new();
+    let conc = decompose(
+        region,
+        &DecomposeOptions {
+            layout: Layout::Concavity,
+            ..opts.clone()
+        },
+    );
+    let conc_err = match conc {
+        Ok(d) => {
+            cands.push(("concavity", d));
+            None
+        }
+        Err(e) => Some(e),
+    };
+    for (name, aspect) in LAYOUT_ASPECTS {
+        let o = DecomposeOptions {
+            chord_aspect: aspect,
+            ..opts.clone()
+        };
+        if let Ok(d) = chord_layout(region, &o) {
+            if !cands.iter().any(|(_, c)| *c == d) {
+                cands.push((name, d));
+            }
+        }
+    }
+    let mut best: Option<(f64, usize, usize, crate::predict::Prediction)> = None;
+    let mut scores = Vec::new();
+    for (k, (name, d)) in cands.iter().enumerate() {
+        let Ok(p) = crate::predict::predict_mesh(d, size) else {
+            continue;
+        };
+        scores.push((name.to_string(), 100.0 * p.good_share));
+        let key = p.good_share
+            + if *name == "concavity" {
+                LAYOUT_MARGIN
+            } else {
+                0.0
+            };
+        let better = match &best {
+            None => true,
+            Some((bk, nb, _, _)) => key > *bk || (key == *bk && d.blocks.len() < *nb),
+        };
+        if better {
+            best = Some((key, d.blocks.len(), k, p));
+        }
+    }
+    match best {
+        Some((_, _, k, p)) => {
+            let (name, d) = cands.swap_remove(k);
+            let choice = LayoutChoice {
+                layout: name.to_string(),
+                predicted_percent: 100.0 * p.good_share,
+                candidates: scores,
+                blocks: p.blocks,
+            };
+            Ok((d, choice))
+        }
+        None => match cands.pop() {
+            Some((name, d)) => Ok((
+                d,
+                LayoutChoice {
+                    layout: name.to_string(),
+                    predicted_percent: f64::NAN,
+                    candidates: scores,
+                    blocks: Vec::new(),
+                },
+            )),
+            None => Err(conc_err
+                .map(CoreError::from)
+                .unwrap_or_else(|| CoreError::Unsupported("no layout".into()))),
+        },
+    }
+}
+
+/// Predicted and achieved μ ≥ 0.8 share of one block (report.json `block_quality`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BlockQuality {
+    /// Block id.
+    pub block: usize,
+    /// Cells of the block in the final mesh.
+    pub cells: usize,
+    /// Predicted μ ≥ 0.8 percentage ([`crate::predict`]).
+    pub predicted: f64,
+    /// Achieved μ ≥ 0.8 percentage in the final mesh.
+    pub achieved: f64,
 }

@@ -237,8 +237,8 @@ impl ChordMesh {
         let (a1, a2) = self.end_angles(a, self.pts[b], reach);
         let (b1, b2) = self.end_angles(b, self.pts[a], reach);
         let m = a1.min(a2).min(b1).min(b2);
-        let g = 0.25
-            * (angle_penalty(a1) + angle_penalty(a2) + angle_penalty(b1) + angle_penalty(b2));
+        let g =
+            0.25 * (angle_penalty(a1) + angle_penalty(a2) + angle_penalty(b1) + angle_penalty(b2));
         (m, g)
     }
 
@@ -619,7 +619,10 @@ mod tests {
         xs.sort_by(f64::total_cmp);
         let mut prev = 0.0;
         for x in xs.iter().chain(std::iter::once(&10.0)) {
-            assert!(x - prev <= 3.0 + 1e-9, "piece {prev}..{x} longer than 3 widths");
+            assert!(
+                x - prev <= 3.0 + 1e-9,
+                "piece {prev}..{x} longer than 3 widths"
+            );
             prev = *x;
         }
     }
