@@ -781,8 +781,9 @@ pub struct LayoutChoice {
 }
 
 /// Builds the concavity layout and the chord layouts of [`LAYOUT_ASPECTS`] of `region` and
-/// keeps the one with the highest predicted μ ≥ 0.8 share ([`crate::predict::predict_mesh`]; the concavity layout wins ties
-/// within [`LAYOUT_MARGIN`], then the one with fewer blocks).
+/// keeps the one with the highest predicted μ ≥ 0.8 share ([`crate::predict::predict_mesh`]):
+/// a layout with fewer interior singularities (cut joints) always wins, the concavity layout
+/// wins ties within [`LAYOUT_MARGIN`], then the one with fewer blocks.
 pub fn choose_layout(
     region: &Region,
     opts: &DecomposeOptions,
@@ -814,29 +815,34 @@ pub fn choose_layout(
             }
         }
     }
-    let mut best: Option<(f64, usize, usize, crate::predict::Prediction)> = None;
+    // key: fewer interior singularities (cut joints, which the triangle-block rule makes when
+    // it must split a cut), then the predicted share, then fewer blocks
+    let mut best: Option<((usize, f64, usize), usize, crate::predict::Prediction)> = None;
     let mut scores = Vec::new();
     for (k, (name, d)) in cands.iter().enumerate() {
         let Ok(p) = crate::predict::predict_mesh(d, size) else {
             continue;
         };
         scores.push((name.to_string(), 100.0 * p.good_share));
-        let key = p.good_share
+        let share = p.good_share
             + if *name == "concavity" {
                 LAYOUT_MARGIN
             } else {
                 0.0
             };
+        let key = (p.singularities, share, d.blocks.len());
         let better = match &best {
             None => true,
-            Some((bk, nb, _, _)) => key > *bk || (key == *bk && d.blocks.len() < *nb),
+            Some((bk, _, _)) => {
+                key.0 < bk.0 || (key.0 == bk.0 && (key.1 > bk.1 || (key.1 == bk.1 && key.2 < bk.2)))
+            }
         };
         if better {
-            best = Some((key, d.blocks.len(), k, p));
+            best = Some((key, k, p));
         }
     }
     match best {
-        Some((_, _, k, p)) => {
+        Some((_, k, p)) => {
             let (name, d) = cands.swap_remove(k);
             let choice = LayoutChoice {
                 layout: name.to_string(),

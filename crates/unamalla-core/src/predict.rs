@@ -43,6 +43,24 @@ pub struct Prediction {
     pub blocks: Vec<f64>,
     /// Cells of the coarse prediction mesh.
     pub cells: usize,
+    /// Interior nodes of the coarse mesh with valence ≠ 4 (a layout with cut joints, or one
+    /// whose blocks do not merge conformally, has some; the pipeline's layouts should not).
+    pub singularities: usize,
+}
+
+/// Interior nodes (not on the boundary of the union) with a valence other than 4.
+pub fn interior_singularities(mesh: &BlockMesh2) -> usize {
+    let g = mesh.global();
+    let boundary = g.boundary_flags();
+    let mut valence = vec![0usize; g.nodes().len()];
+    for c in g.cells() {
+        for &v in c {
+            valence[v] += 1;
+        }
+    }
+    (0..valence.len())
+        .filter(|&i| !boundary[i] && valence[i] != 4)
+        .count()
 }
 
 /// Share of the cells of block `b` of `mesh` (global node coordinates) with μ ≥ 0.8, and the
@@ -116,6 +134,7 @@ pub fn predict_mesh(d: &Decomposition, size: MeshSize) -> Result<Prediction, Cor
     let (curves, counts) = compatible_counts(d, coarse)?;
     let grids = curves.grids(d, &counts.counts)?;
     let mut mesh = BlockMesh2::merge(grids, 1e-9)?;
+    let singularities = interior_singularities(&mesh);
     laplacian_sweeps(&mut mesh, PREDICT_SWEEPS);
     let mut good = 0.0;
     let mut total = 0usize;
@@ -130,5 +149,6 @@ pub fn predict_mesh(d: &Decomposition, size: MeshSize) -> Result<Prediction, Cor
         good_share: good / total.max(1) as f64,
         blocks,
         cells: mesh.num_quads(),
+        singularities,
     })
 }
