@@ -782,7 +782,7 @@ pub struct LayoutChoice {
 
 /// Builds the concavity layout and the chord layouts of [`LAYOUT_ASPECTS`] of `region` and
 /// keeps the one with the highest predicted μ ≥ 0.8 share ([`crate::predict::predict_mesh`]):
-/// a layout with fewer interior singularities (cut joints) always wins, the concavity layout
+/// a layout with fewer rule breaks (interior singularities, non-admissible blocks) always wins, the concavity layout
 /// wins ties within [`LAYOUT_MARGIN`], then the one with fewer blocks.
 pub fn choose_layout(
     region: &Region,
@@ -815,8 +815,9 @@ pub fn choose_layout(
             }
         }
     }
-    // key: fewer interior singularities (cut joints, which the triangle-block rule makes when
-    // it must split a cut), then the predicted share, then fewer blocks
+    // key: fewer rule breaks (interior singularities — cut joints, which the triangle-block
+    // rule makes when it must split a cut — and blocks that are not admissible), then the
+    // predicted share, then fewer blocks
     let mut best: Option<((usize, f64, usize), usize, crate::predict::Prediction)> = None;
     let mut scores = Vec::new();
     for (k, (name, d)) in cands.iter().enumerate() {
@@ -830,7 +831,10 @@ pub fn choose_layout(
             } else {
                 0.0
             };
-        let key = (p.singularities, share, d.blocks.len());
+        let inadmissible = (0..d.blocks.len())
+            .filter(|&b| !d.block_admissible(b, &opts.tolerances))
+            .count();
+        let key = (p.singularities + inadmissible, share, d.blocks.len());
         let better = match &best {
             None => true,
             Some((bk, _, _)) => {
