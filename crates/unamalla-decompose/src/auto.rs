@@ -163,21 +163,54 @@ pub fn chord_layout(
     )
     .map_err(|e| DecomposeError::Layout(e.0))?;
     let tol = crate::decomposition::boundary_tol(region);
-    let mut b = Builder::new(region, opts);
-    for (p, q) in cuts {
-        // a cut no piece admits (rounding at a sample point) is skipped: Algorithm 1 then
-        // treats that piece as it would without the layout
-        b.apply_cut(p, q, tol, Step::Chord);
+    let mut cuts = cuts;
+    // up to ARM_ROUNDS times: blocks that still keep an arm (a part ≥ ARM_SCORE chord widths
+    // beyond a chord between two boundary points) get that chord as one more layout cut
+    let mut d = None;
+    for round in 0..=ARM_ROUNDS {
+        let mut b = Builder::new(region, opts);
+        for &(p, q) in &cuts {
+            // a cut no piece admits (rounding at a sample point) is skipped: Algorithm 1
+            // then treats that piece as it would without the layout
+            b.apply_cut(p, q, tol, Step::Chord);
+        }
+        b.protected_cuts = b.cuts.len();
+        let leaves: Vec<usize> = (0..b.nodes.len())
+            .filter(|&n| b.pieces[n].is_some())
+            .collect();
+        for n in leaves {
+            b.run_auto(n)?;
+        }
+        let dec = b.finish()?;
+        let extra: Vec<(DVec2, DVec2)> = if round < ARM_ROUNDS {
+            dec.blocks
+                .iter()
+                .filter_map(|blk| {
+                    let on: Vec<bool> = blk
+                        .edges
+                        .iter()
+                        .map(|e| matches!(e, EdgeKind::Boundary { .. }))
+                        .collect();
+                    crate::chords::arm_chord(&blk.ring, &on, ARM_SCORE)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        d = Some(dec);
+        if extra.is_empty() {
+            break;
+        }
+        cuts.extend(extra);
     }
-    b.protected_cuts = b.cuts.len();
-    let leaves: Vec<usize> = (0..b.nodes.len())
-        .filter(|&n| b.pieces[n].is_some())
-        .collect();
-    for n in leaves {
-        b.run_auto(n)?;
-    }
-    b.finish()
+    d.ok_or_else(|| DecomposeError::Layout("no decomposition".into()))
 }
+
+/// A block part extending at least this many chord widths beyond a chord (the chord's
+/// `min(A₁, A₂)/w²`, module `chords`) is an arm: the chord layout cuts it off.
+pub const ARM_SCORE: f64 = 4.0;
+/// Rounds of arm cuts after the first decomposition.
+const ARM_ROUNDS: usize = 2;
 
 /// What [`Builder::apply_cut`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -55,6 +55,9 @@ pub(crate) struct ChordMesh {
     pub ring_start: Vec<usize>,
     /// Arc-length position of each sample along its ring.
     pub arc: Vec<f64>,
+    /// Edge of its ring each sample lies on (`i` for the edge from vertex `i` to `i + 1`;
+    /// samples at vertex `i` count as on edge `i`).
+    pub edge: Vec<usize>,
     /// Perimeter of each ring.
     pub ring_len: Vec<f64>,
     /// Inside triangles (sample indices).
@@ -62,8 +65,9 @@ pub(crate) struct ChordMesh {
     /// `nbr[t][k]`: the inside triangle across edge `(tris[t][k], tris[t][(k+1)%3])`, if that
     /// edge is not a boundary edge.
     pub nbr: Vec<[Option<usize>; 3]>,
-    /// Sample spacing.
-    pub spacing: f64,
+    /// Sample spacing per ring: the requested spacing, or a sixteenth of the ring's
+    /// perimeter for a small ring (so a small island still has chords all around it).
+    pub ring_spacing: Vec<f64>,
 }
 
 /// Why the chord layout could not be computed (the caller falls back to the concavity
@@ -72,8 +76,11 @@ pub(crate) struct ChordMesh {
 pub(crate) struct ChordError(pub String);
 
 impl ChordMesh {
-    /// Samples every ring every `spacing` (original vertices kept) and triangulates.
+    /// Samples every ring every `spacing` (at most a sixteenth of its perimeter; original
+    /// vertices kept) and triangulates.
     pub fn new(region: &Region, spacing: f64) -> Result<Self, ChordError> {
+        let mut ring_spacing = Vec::new();
+        let mut edge = Vec::new();
         let mut pts = Vec::new();
         let mut ring = Vec::new();
         let mut ring_start = Vec::new();
@@ -83,6 +90,8 @@ impl ChordMesh {
             ring_start.push(pts.len());
             let p = poly.points();
             let n = p.len();
+            let spacing = spacing.min(poly.perimeter() / 16.0);
+            ring_spacing.push(spacing);
             let mut s_acc = 0.0;
             for i in 0..n {
                 let (a, b) = (p[i], p[(i + 1) % n]);
@@ -93,6 +102,7 @@ impl ChordMesh {
                     pts.push(a.lerp(b, t));
                     ring.push(r);
                     arc.push(s_acc + t * len);
+                    edge.push(i);
                 }
                 s_acc += len;
             }
@@ -198,11 +208,17 @@ impl ChordMesh {
             ring,
             ring_start,
             arc,
+            edge,
             ring_len,
             tris,
             nbr,
-            spacing,
+            ring_spacing,
         })
+    }
+
+    /// Sample spacing at sample `i`.
+    fn spacing(&self, i: usize) -> f64 {
+        self.ring_spacing[self.ring[i]]
     }
 
     fn next_on_ring(&self, i: usize, steps: usize) -> usize {
@@ -223,7 +239,7 @@ impl ChordMesh {
     fn end_angles(&self, i: usize, target: DVec2, reach: f64) -> (f64, f64) {
         let r = self.ring[i];
         let n = self.ring_start[r + 1] - self.ring_start[r];
-        let steps = ((reach / self.spacing).round() as usize).clamp(1, (n / 4).max(1));
+        let steps = ((reach / self.ring_spacing[r]).round() as usize).clamp(1, (n / 4).max(1));
         let next = self.pts[self.next_on_ring(i, steps)];
         let prev = self.pts[self.prev_on_ring(i, steps)];
         let cur = self.pts[i];
@@ -233,9 +249,8 @@ impl ChordMesh {
     /// `(min angle, ḡ)` of chord `(a, b)`.
     fn chord_angles(&self, a: usize, b: usize) -> (f64, f64) {
         let w = self.pts[a].distance(self.pts[b]);
-        let reach = (0.5 * w).max(self.spacing);
-        let (a1, a2) = self.end_angles(a, self.pts[b], reach);
-        let (b1, b2) = self.end_angles(b, self.pts[a], reach);
+        let (a1, a2) = self.end_angles(a, self.pts[b], (0.5 * w).max(self.spacing(a)));
+        let (b1, b2) = self.end_angles(b, self.pts[a], (0.5 * w).max(self.spacing(b)));
         let m = a1.min(a2).min(b1).min(b2);
         let g =
             0.25 * (angle_penalty(a1) + angle_penalty(a2) + angle_penalty(b1) + angle_penalty(b2));
@@ -265,6 +280,147 @@ impl ChordMesh {
             .perp_dot(self.pts[c] - self.pts[a])
             .abs()
     }
+}
+
+/// The dual spanning tree of one simply connected piece of a [`ChordMesh`]: triangles in DFS
+/// preorder, each one's parent and the dual edge to it, and subtree areas.
+struct PieceTree {
+    order: Vec<usize>,
+    parent: BTreeMap<usize, (usize, usize)>,
+    sub: BTreeMap<usize, f64>,
+    total: f64,
+}
+
+impl PieceTree {
+    /// The tree of the piece containing `seed`, crossing only the edges `open(t, k)` returns a
+    /// neighbour for; `None` if the piece's dual graph has a cycle (a hole inside the piece).
+    fn new(
+        m: &ChordMesh,
+        seed: usize,
+        open: &dyn Fn(usize, usize) -> Option<usize>,
+    ) -> Option<Self> {
+        let mut parent: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
+        let mut seen: HashSet<usize> = HashSet::from([seed]);
+        let mut dfs = vec![seed];
+        let mut order = Vec::new();
+        let mut dual_edges = 0usize;
+        while let Some(x) = dfs.pop() {
+            order.push(x);
+            for k in 0..3 {
+                if let Some(u) = open(x, k) {
+                    dual_edges += 1;
+                    if seen.insert(u) {
+                        parent.insert(u, (x, k));
+                        dfs.push(u);
+                    }
+                }
+            }
+        }
+        if dual_edges / 2 + 1 != order.len() {
+            return None;
+        }
+        let mut sub: BTreeMap<usize, f64> = BTreeMap::new();
+        for &x in order.iter().rev() {
+            let s = m.tri_area(x) + sub.get(&x).copied().unwrap_or(0.0);
+            sub.insert(x, s);
+            if let Some(&(p, _)) = parent.get(&x) {
+                *sub.entry(p).or_insert(0.0) += s;
+            }
+        }
+        let total = sub.get(&seed).copied().unwrap_or(0.0);
+        Some(Self {
+            order,
+            parent,
+            sub,
+            total,
+        })
+    }
+
+    /// Every chord of the piece with the areas on its two sides: `(a, b, A_child, x)` where
+    /// `x` is the triangle on the child side.
+    fn chords<'a>(
+        &'a self,
+        m: &'a ChordMesh,
+    ) -> impl Iterator<Item = (usize, usize, f64, usize)> + 'a {
+        self.order.iter().filter_map(move |&x| {
+            let &(p, k) = self.parent.get(&x)?;
+            let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
+            Some((a, b, self.sub.get(&x).copied().unwrap_or(0.0), x))
+        })
+    }
+}
+
+/// The **neck score** of a simple polygon (a block): the largest `min(A₁, A₂)/w²` over its
+/// chords (module docs) — how many chord widths the smaller side extends beyond its
+/// narrowest chord. A convex, roughly square block scores ≤ ½; a block that keeps a narrow arm
+/// or a long tongue scores high. Used by the category tests of issue #22.
+pub fn neck_score(ring: &[DVec2]) -> f64 {
+    let Ok(region) = Region::new(ring.to_vec(), vec![]) else {
+        return f64::NAN;
+    };
+    let per = region.perimeter();
+    let Ok(m) = ChordMesh::new(&region, per / 400.0) else {
+        return f64::NAN;
+    };
+    let open = |t: usize, k: usize| m.nbr[t][k];
+    if m.tris.is_empty() {
+        return 0.0;
+    }
+    let Some(tree) = PieceTree::new(&m, 0, &open) else {
+        return f64::NAN;
+    };
+    tree.chords(&m)
+        .map(|(a, b, a1, _)| a1.min(tree.total - a1) / m.pts[a].distance_squared(m.pts[b]))
+        .fold(0.0, f64::max)
+}
+
+/// The best **arm cut** of a block: the chord with the highest `min(A₁, A₂)/w²`, at least
+/// `min_score`, whose ends both lie on edges with `on_boundary[i]` (original region boundary,
+/// so the chord is a valid cut of the region), strictly inside those edges or at their
+/// vertices, and that meets the boundary at no less than [`MIN_END_ANGLE_DEG`].
+pub(crate) fn arm_chord(
+    ring: &[DVec2],
+    on_boundary: &[bool],
+    min_score: f64,
+) -> Option<(DVec2, DVec2)> {
+    let region = Region::new(ring.to_vec(), vec![]).ok()?;
+    let m = ChordMesh::new(&region, region.perimeter() / 400.0).ok()?;
+    if m.tris.is_empty() {
+        return None;
+    }
+    let open = |t: usize, k: usize| m.nbr[t][k];
+    let tree = PieceTree::new(&m, 0, &open)?;
+    // Region::new may have reversed the ring: map edges by their end points
+    let n = ring.len();
+    let boundary_edge = |i: usize| {
+        let (a, b) = (
+            region.outer().points()[i],
+            region.outer().points()[(i + 1) % n],
+        );
+        (0..n).any(|k| {
+            on_boundary[k]
+                && ((ring[k] == a && ring[(k + 1) % n] == b)
+                    || (ring[k] == b && ring[(k + 1) % n] == a))
+        })
+    };
+    let min_angle = MIN_END_ANGLE_DEG.to_radians();
+    let mut best: Option<(f64, usize, usize)> = None;
+    for (a, b, a1, _) in tree.chords(&m) {
+        let w2 = m.pts[a].distance_squared(m.pts[b]);
+        let score = a1.min(tree.total - a1) / w2;
+        if score < min_score || best.is_some_and(|(s, _, _)| s >= score) {
+            continue;
+        }
+        if !boundary_edge(m.edge[a]) || !boundary_edge(m.edge[b]) {
+            continue;
+        }
+        let (amin, _) = m.chord_angles(a, b);
+        if amin < min_angle {
+            continue;
+        }
+        best = Some((score, a, b));
+    }
+    best.map(|(_, a, b)| (m.pts[a], m.pts[b]))
 }
 
 /// The layout cuts of a region, in the order they must be applied (bridges from the outer
@@ -392,8 +548,11 @@ pub(crate) fn layout_cuts(
                 if p.iter().all(|&e| e == usize::MAX || covered[e]) {
                     continue;
                 }
-                let d = m.spacing.max(near_frac * m.pts[a].distance(m.pts[b]));
-                let near = |x: usize| ends.iter().any(|&e| m.pts[e].distance(m.pts[x]) <= d);
+                let w = m.pts[a].distance(m.pts[b]);
+                let near = |x: usize| {
+                    let d = m.spacing(x).max(near_frac * w);
+                    ends.iter().any(|&e| m.pts[e].distance(m.pts[x]) <= d)
+                };
                 if near(a) || near(b) {
                     continue;
                 }
@@ -475,43 +634,13 @@ pub(crate) fn layout_cuts(
         if steps > budget {
             break;
         }
-        // DFS tree of the piece
-        let mut parent: BTreeMap<usize, (usize, usize)> = BTreeMap::new(); // tri → (parent, k)
-        let mut seen: HashSet<usize> = HashSet::from([seed]);
-        let mut dfs = vec![seed];
-        let mut order_t = Vec::new();
-        let mut dual_edges = 0usize;
-        while let Some(x) = dfs.pop() {
-            order_t.push(x);
-            for k in 0..3 {
-                if let Some(u) = open(x, k, &cut_set) {
-                    dual_edges += 1;
-                    if seen.insert(u) {
-                        parent.insert(u, (x, k));
-                        dfs.push(u);
-                    }
-                }
-            }
-        }
-        if dual_edges / 2 + 1 != order_t.len() {
+        let open_here = |t: usize, k: usize| open(t, k, &cut_set);
+        let Some(tree) = PieceTree::new(&m, seed, &open_here) else {
             continue; // not simply connected (should not happen): leave it to Algorithm 1
-        }
-        let mut sub: BTreeMap<usize, f64> = BTreeMap::new();
-        for &x in order_t.iter().rev() {
-            let s = m.tri_area(x) + sub.get(&x).copied().unwrap_or(0.0);
-            sub.insert(x, s);
-            if let Some(&(p, _)) = parent.get(&x) {
-                *sub.entry(p).or_insert(0.0) += s;
-            }
-        }
-        let total = sub.get(&seed).copied().unwrap_or(0.0);
+        };
+        let total = tree.total;
         let mut best: Option<(f64, usize, usize, usize)> = None;
-        for &x in &order_t {
-            let Some(&(p, k)) = parent.get(&x) else {
-                continue;
-            };
-            let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
-            let a1 = sub.get(&x).copied().unwrap_or(0.0);
+        for (a, b, a1, x) in tree.chords(&m) {
             let small = a1.min(total - a1);
             if small < min_area {
                 continue;
@@ -529,10 +658,10 @@ pub(crate) fn layout_cuts(
             if score < aspect {
                 continue;
             }
-            let d = m.spacing.max(0.5 * w);
+            let (da, db) = (m.spacing(a).max(0.5 * w), m.spacing(b).max(0.5 * w));
             if ends
                 .iter()
-                .any(|&e| m.pts[e].distance(m.pts[a]) <= d || m.pts[e].distance(m.pts[b]) <= d)
+                .any(|&e| m.pts[e].distance(m.pts[a]) <= da || m.pts[e].distance(m.pts[b]) <= db)
             {
                 continue;
             }
@@ -595,6 +724,33 @@ mod tests {
         let m = ChordMesh::new(&r, 0.5).expect("triangulation");
         let a: f64 = (0..m.tris.len()).map(|t| m.tri_area(t)).sum();
         assert!((a - 12.0).abs() < 1e-9, "area {a}");
+    }
+
+    #[test]
+    fn neck_scores_of_a_square_and_a_dumbbell() {
+        let v = DVec2::new;
+        // square: the best chord is a midline, w = 1 and A = ½ on each side → ½
+        let sq = [v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
+        let s = neck_score(&sq);
+        assert!(s <= 0.5 + 1e-9 && s > 0.45, "{s}");
+        // two 4 × 4 squares joined by a 1 × 1 neck: the chord across the neck has w = 1 and
+        // at least 16 on each side
+        let db = [
+            v(0.0, 0.0),
+            v(4.0, 0.0),
+            v(4.0, 1.5),
+            v(5.0, 1.5),
+            v(5.0, 0.0),
+            v(9.0, 0.0),
+            v(9.0, 4.0),
+            v(5.0, 4.0),
+            v(5.0, 2.5),
+            v(4.0, 2.5),
+            v(4.0, 4.0),
+            v(0.0, 4.0),
+        ];
+        let d = neck_score(&db);
+        assert!(d >= 16.0, "{d}");
     }
 
     #[test]
