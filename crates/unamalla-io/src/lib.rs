@@ -89,9 +89,11 @@
 
 pub mod atomic;
 pub mod error;
+pub mod geo;
 pub mod geojson;
 pub mod legacy;
 pub mod msh;
+pub mod patches;
 pub mod plot3d;
 pub mod rings;
 pub mod shp;
@@ -104,10 +106,12 @@ mod xml;
 
 pub use atomic::atomic_write;
 pub use error::IoError;
+pub use geo::{looks_geographic, CrsChoice, LocalProjection};
 pub use geojson::{
-    parse_polygon_parts, parse_region_geojson, parse_region_geojson_cleaned, parse_region_rings,
+    parse_annotated_region_geojson, parse_polygon_parts, parse_region_geojson,
+    parse_region_geojson_cleaned, parse_region_rings, read_annotated_region_geojson,
     read_region_geojson, read_region_geojson_cleaned, read_region_rings, region_to_geojson,
-    write_region_geojson, PartSelector, PolygonRings,
+    write_region_geojson, PartSelector, PolygonRings, RegionAnnotations,
 };
 pub use legacy::{
     parse_con, parse_geomview_mesh, parse_red, parse_xy, read_con, read_geomview_mesh, read_red,
@@ -118,6 +122,7 @@ pub use msh::{
     boundary_edge_groups, boundary_loops, hex_boundary_faces, parse_msh, read_msh, write_msh_hexes,
     write_msh_quads, BoundaryLoop, EdgeGroup, FaceGroup, MshFile, MshMesh,
 };
+pub use patches::{named_edge_groups, BoundaryNames, Stretch};
 pub use plot3d::{
     parse_plot3d_ascii, parse_plot3d_binary, read_plot3d, write_plot3d2, write_plot3d3,
     Plot3dBlocks, Plot3dDim, Plot3dFormat,
