@@ -17,6 +17,8 @@
 //! | Plot3D multi-block grids, 2D and 3D, ASCII and Fortran-unformatted binary | yes | yes | [`plot3d`] |
 //! | UNAMALLA XY and RED meshes | yes | yes | [`legacy`] |
 //! | Geomview `MESH` surface | yes | yes | [`legacy`] |
+//! | SU2 native `.su2` (quads, markers = boundary patches) | – | yes | [`solver`] |
+//! | OpenFOAM `constant/polyMesh` (extruded one cell, `frontAndBack` empty, named patches) | – | yes | [`solver`] |
 //! | OFF / Wavefront OBJ (quad meshes; hex meshes as boundary surfaces) | polygon surfaces | yes | [`surface`] |
 //!
 //! Every mesh writer takes per-cell arrays where the format has them (VTK legacy and XML: e.g.
@@ -28,6 +30,10 @@
 //! (`check_msh_gmsh.py`, PyPI `gmsh`), meshio (`check_vtk_meshio.py`, `.vtk` and `.vtu`) and
 //! VTK's XML readers (`check_vtk_xml_vtk.py`, PyPI `vtk`, `.vts`/`.vtu`/`.vtm`; meshio has no
 //! `.vts` reader).
+//!
+//! Boundary-condition names ([`patches`]) come from GeoJSON properties or the library API and
+//! are carried to every mesh output; longitude/latitude input is projected to a local
+//! transverse Mercator in km ([`geo`]).
 //!
 //! ## Conventions
 //!
@@ -97,6 +103,7 @@ pub mod patches;
 pub mod plot3d;
 pub mod rings;
 pub mod shp;
+pub mod solver;
 pub mod surface;
 pub mod vtk;
 pub mod vtk_xml;
@@ -119,8 +126,9 @@ pub use legacy::{
     GeomviewMesh, Ibflag, LegacyMesh,
 };
 pub use msh::{
-    boundary_edge_groups, boundary_loops, hex_boundary_faces, parse_msh, read_msh, write_msh_hexes,
-    write_msh_quads, BoundaryLoop, EdgeGroup, FaceGroup, MshFile, MshMesh,
+    boundary_edge_groups, boundary_loops, hex_boundary_faces, parse_msh, read_msh,
+    write_msh_blocks, write_msh_hexes, write_msh_quads, BoundaryLoop, EdgeGroup, FaceGroup,
+    MshFile, MshMesh,
 };
 pub use patches::{named_edge_groups, BoundaryNames, Stretch};
 pub use plot3d::{
@@ -134,6 +142,7 @@ pub use shp::{
     encode_region_shapefile, parse_shapefile_parts, read_region_shapefile, read_shapefile_parts,
     write_region_shapefile,
 };
+pub use solver::{foam_mesh, su2_text, write_openfoam, write_su2, FoamMesh};
 pub use surface::{
     parse_obj, parse_off, read_obj, read_off, write_obj_hexes, write_obj_quads, write_off_hexes,
     write_off_quads, SurfaceMesh,
