@@ -306,6 +306,15 @@ pub enum IoError {
         reason: String,
     },
 
+    /// A `--feature KEY=VALUE` selector matched no polygon (or is malformed).
+    #[error("--feature {selector:?}: {reason}")]
+    FeatureNotFound {
+        /// The selector as given.
+        selector: String,
+        /// Why nothing was selected.
+        reason: String,
+    },
+
     /// A coordinate reference system could not be set up or applied (see [`crate::geo`]).
     #[error("coordinate system: {0}")]
     Crs(String),

@@ -537,12 +537,17 @@ fn annotated_at(
         column: e.column(),
         message: strip_position(&e.to_string()),
     })?;
-    let ann = annotations(&value, &rings.json_path, path)?;
+    let ann = annotations_of(&value, &rings.json_path, path)?;
     let (region, removed) = to_region(rings, path, true)?;
     Ok((region, removed, ann))
 }
 
-fn annotations(value: &Value, part_path: &str, path: &Path) -> Result<RegionAnnotations, IoError> {
+/// The annotations of the polygon at `part_path` of a parsed document.
+pub(crate) fn annotations_of(
+    value: &Value,
+    part_path: &str,
+    path: &Path,
+) -> Result<RegionAnnotations, IoError> {
     let bad = |jp: String, problem: String| IoError::MissingMember {
         path: path.to_path_buf(),
         json_path: jp,

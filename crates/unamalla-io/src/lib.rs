@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | GeoJSON (RFC 7946) `Polygon` / `MultiPolygon` / `Feature` / `FeatureCollection` | regions | – | [`geojson`] |
 //! | ESRI Shapefile, polygon shapes (5, 15, 25) | regions | regions (`.shp` + `.shx`) | [`shp`] |
+//! | dBASE `.dbf` attribute tables (the shapefile's `--feature` selector) | records | – | [`dbf`] |
 //! | UNAMALLA contour `.con` (`ibflag` 0/1/13/24, side counts) | contours, regions | contours | [`legacy`] |
 //! | plain text rings (`x y` per line, blank line between rings) | regions | regions | [`rings`] |
 //! | Gmsh MSH 4.1 ASCII: quads (3) / hexahedra (5), `$Entities`, `$PhysicalNames`, named boundary groups | yes | yes | [`msh`] |
@@ -94,9 +95,11 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod atomic;
+pub mod dbf;
 pub mod error;
 pub mod geo;
 pub mod geojson;
+pub mod input;
 pub mod legacy;
 pub mod msh;
 pub mod patches;
@@ -120,6 +123,7 @@ pub use geojson::{
     read_region_geojson, read_region_geojson_cleaned, read_region_rings, region_to_geojson,
     write_region_geojson, PartSelector, PolygonRings, RegionAnnotations,
 };
+pub use input::{load_region, LoadOptions, LoadedRegion};
 pub use legacy::{
     parse_con, parse_geomview_mesh, parse_red, parse_xy, read_con, read_geomview_mesh, read_red,
     read_region_con, read_xy, write_con, write_geomview_mesh, write_red, write_xy, Contour,
