@@ -20,6 +20,7 @@
 //! | Geomview `MESH` surface | yes | yes | [`legacy`] |
 //! | SU2 native `.su2` (quads, markers = boundary patches) | – | yes | [`solver`] |
 //! | OpenFOAM `constant/polyMesh` (extruded one cell, `frontAndBack` empty, named patches) | – | yes | [`solver`] |
+//! | CGNS structured multi-zone (zone per block, 1-to-1 connectivity, BCs by patch; feature `cgns`) | – | yes | `cgns` |
 //! | OFF / Wavefront OBJ (quad meshes; hex meshes as boundary surfaces) | polygon surfaces | yes | [`surface`] |
 //!
 //! Every mesh writer takes per-cell arrays where the format has them (VTK legacy and XML: e.g.
@@ -95,6 +96,8 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod atomic;
+#[cfg(feature = "cgns")]
+pub mod cgns;
 pub mod dbf;
 pub mod error;
 pub mod geo;

@@ -27,8 +27,8 @@
 //!
 //! [`write_openfoam`] writes `points`, `faces`, `owner`, `neighbour` and `boundary` (ASCII,
 //! `FoamFile` headers with the `note` OpenFOAM's `checkMesh` prints: nPoints, nCells, nFaces,
-//! nInternalFaces), each atomically, and a minimal `system/controlDict` so the directory is a
-//! case `checkMesh -case <dir>` accepts.
+//! nInternalFaces), each atomically, and minimal `system/{controlDict,fvSchemes,fvSolution}` so the
+//! directory is a case `checkMesh -case <dir>` accepts.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -225,7 +225,7 @@ fn foam_header(class: &str, object: &str, note: &str) -> String {
 
 /// Writes the extruded mesh ([`foam_mesh`], `thickness` > 0) as an OpenFOAM case directory
 /// `case`: `constant/polyMesh/{points,faces,owner,neighbour,boundary}` and
-/// `system/controlDict`.
+/// `system/{controlDict,fvSchemes,fvSolution}`.
 pub fn write_openfoam<M: HasQuadCells + ?Sized>(
     case: impl AsRef<Path>,
     mesh: &M,
@@ -306,9 +306,23 @@ pub fn write_openfoam<M: HasQuadCells + ?Sized>(
         atomic_write(&poly.join(name), |w| w.write_all(text.as_bytes()))?;
     }
     let control = "FoamFile\n{\n    version     2.0;\n    format      ascii;\n    class       dictionary;\n    location    \"system\";\n    object      controlDict;\n}\n\napplication     foamRun;\nstartFrom       startTime;\nstartTime       0;\nstopAt          endTime;\nendTime         1;\ndeltaT          1;\nwriteControl    timeStep;\nwriteInterval   1;\n";
-    atomic_write(&case.join("system").join("controlDict"), |w| {
-        w.write_all(control.as_bytes())
-    })?;
+    let dict = |object: &str, body: &str| {
+        format!("FoamFile\n{{\n    version     2.0;\n    format      ascii;\n    class       dictionary;\n    location    \"system\";\n    object      {object};\n}}\n\n{body}")
+    };
+    let schemes = dict(
+        "fvSchemes",
+        "ddtSchemes { default Euler; }\ngradSchemes { default Gauss linear; }\ndivSchemes { default none; }\nlaplacianSchemes { default Gauss linear corrected; }\ninterpolationSchemes { default linear; }\nsnGradSchemes { default corrected; }\n",
+    );
+    let solution = dict("fvSolution", "solvers {}\n");
+    for (name, text) in [
+        ("controlDict", control.to_string()),
+        ("fvSchemes", schemes),
+        ("fvSolution", solution),
+    ] {
+        atomic_write(&case.join("system").join(name), |w| {
+            w.write_all(text.as_bytes())
+        })?;
+    }
     Ok(fm)
 }
 
@@ -351,8 +365,8 @@ mod tests {
         let centre = |ids: &[usize]| {
             let mut c = [0.0; 3];
             for &v in ids {
-                for k in 0..3 {
-                    c[k] += fm.points[v][k] / ids.len() as f64;
+                for (ck, pk) in c.iter_mut().zip(fm.points[v]) {
+                    *ck += pk / ids.len() as f64;
                 }
             }
             c
