@@ -12,7 +12,7 @@ use std::collections::HashMap;
 
 use unamalla_compat_ilp::{self as ilp, CompatProblem};
 use unamalla_decompose::{Decomposition, EdgeKind};
-use unamalla_mesh::resample::{polyline_length, resample_arc_length};
+use unamalla_mesh::resample::{cumulative_lengths, polyline_length, resample_arc_length};
 use unamalla_mesh::{tfi2, DVec2, StructuredGrid2, TfiParams};
 
 use crate::pipeline::MeshSize;
@@ -183,7 +183,7 @@ impl BlockCurves {
                     }
                     v
                 }
-                None => resample_arc_length(p, m)?,
+                None => resample_keeping_corners(p, m, CORNER_TURN_DEG)?,
             };
             sampled.push(pts);
         }
@@ -211,6 +211,98 @@ impl BlockCurves {
         }
         Ok(grids)
     }
+}
+
+/// Turning angle (degrees) above which an interior vertex of a boundary curve is a corner that
+/// the resampling keeps as a node ([`resample_keeping_corners`]).
+pub const CORNER_TURN_DEG: f64 = 20.0;
+
+/// `m ≥ 2` points on the polyline `p`, by arc length, except that the sharpest interior vertices
+/// turning by more than `min_turn_deg` (at most `m − 2` of them) are nodes: the polyline is split
+/// there and its `m − 1` segments are shared among the pieces in proportion to their lengths
+/// (largest remainders, at least one each). Plain arc-length resampling cuts such a corner with a
+/// chord up to a segment long, so the mesh boundary leaves the region there when the counts are
+/// small.
+pub fn resample_keeping_corners(
+    p: &[DVec2],
+    m: usize,
+    min_turn_deg: f64,
+) -> Result<Vec<DVec2>, CoreError> {
+    let m = m.max(2);
+    let cos_max = min_turn_deg.to_radians().cos();
+    // interior vertices by turning angle (sharpest first, ties by position)
+    let mut corners: Vec<(f64, usize)> = (1..p.len().saturating_sub(1))
+        .filter_map(|i| {
+            let a = p[i] - p[i - 1];
+            let b = p[i + 1] - p[i];
+            let (la, lb) = (a.length(), b.length());
+            if la == 0.0 || lb == 0.0 {
+                return None;
+            }
+            let c = a.dot(b) / (la * lb);
+            (c < cos_max).then_some((c, i))
+        })
+        .collect();
+    corners.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    // a kept corner is at least half a mean segment from the ends and from the other kept
+    // corners, so no piece gets a segment much shorter than the rest
+    let arc = cumulative_lengths(p);
+    let total = arc[arc.len() - 1];
+    let gap = 0.5 * total / (m - 1) as f64;
+    let mut kept: Vec<usize> = Vec::new();
+    for &(_, i) in &corners {
+        if kept.len() + 2 >= m {
+            break;
+        }
+        let far = |a: f64| (arc[i] - a).abs() >= gap;
+        if far(0.0) && far(total) && kept.iter().all(|&k| far(arc[k])) {
+            kept.push(i);
+        }
+    }
+    if kept.is_empty() {
+        return Ok(resample_arc_length(p, m)?);
+    }
+    let mut cuts: Vec<usize> = kept;
+    cuts.sort_unstable();
+    let mut bounds = vec![0];
+    bounds.extend(cuts);
+    bounds.push(p.len() - 1);
+    let pieces: Vec<&[DVec2]> = bounds.windows(2).map(|w| &p[w[0]..=w[1]]).collect();
+    let lengths: Vec<f64> = pieces.iter().map(|q| polyline_length(q)).collect();
+    let segs = m - 1;
+    let spare = segs - pieces.len();
+    let share: Vec<f64> = lengths
+        .iter()
+        .map(|l| {
+            if total > 0.0 {
+                l / total * spare as f64
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut alloc: Vec<usize> = share.iter().map(|s| 1 + s.floor() as usize).collect();
+    let mut left = segs - alloc.iter().sum::<usize>();
+    let mut order: Vec<usize> = (0..pieces.len()).collect();
+    order.sort_by(|&a, &b| {
+        (share[b] - share[b].floor())
+            .total_cmp(&(share[a] - share[a].floor()))
+            .then(a.cmp(&b))
+    });
+    for &i in order.iter().cycle().take(pieces.len() * 2) {
+        if left == 0 {
+            break;
+        }
+        alloc[i] += 1;
+        left -= 1;
+    }
+    let mut out: Vec<DVec2> = Vec::with_capacity(m);
+    for (q, &k) in pieces.iter().zip(&alloc) {
+        let pts = resample_arc_length(q, k + 1)?;
+        let skip = usize::from(!out.is_empty());
+        out.extend_from_slice(&pts[skip..]);
+    }
+    Ok(out)
 }
 
 /// The area of the decomposed region: the sum of the block areas.

@@ -113,3 +113,34 @@ fn a_cell_size_gives_the_matching_count() {
     let ratio = counts.predicted_cells as f64 / want;
     assert!((ratio - 1.0).abs() <= 0.02 + 1e-9, "{ratio}");
 }
+
+#[test]
+fn resampling_keeps_the_corners_of_a_boundary_curve() {
+    use unamalla_core::curves::resample_keeping_corners;
+    // an L of two legs of 10 with 4 points: by arc length alone (3 segments of 20/3) the corner
+    // (10, 0) would be cut by the chord (20/3, 0)–(10, 10/3); kept, the legs share the 3
+    // segments 2 + 1 (shares 1 + ½ each, the tie to the first leg)
+    let l = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(10.0, 0.0),
+        DVec2::new(10.0, 10.0),
+    ];
+    let p = resample_keeping_corners(&l, 4, 20.0).unwrap();
+    let want = [(0.0, 0.0), (5.0, 0.0), (10.0, 0.0), (10.0, 10.0)];
+    assert_eq!(p.len(), 4);
+    for (q, w) in p.iter().zip(want) {
+        assert!(q.distance(DVec2::new(w.0, w.1)) < 1e-12, "{q} vs {w:?}");
+    }
+    // a turn below the threshold is resampled by arc length
+    let flat = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(10.0, 0.0),
+        DVec2::new(20.0, 1.0),
+    ];
+    let p = resample_keeping_corners(&flat, 4, 20.0).unwrap();
+    let plain = unamalla_core::mesh::resample::resample_arc_length(&flat, 4).unwrap();
+    assert_eq!(p, plain);
+    // two points: only the ends
+    let p = resample_keeping_corners(&l, 2, 20.0).unwrap();
+    assert_eq!(p, vec![l[0], l[2]]);
+}
