@@ -228,6 +228,16 @@ pub fn resample_keeping_corners(
     m: usize,
     min_turn_deg: f64,
 ) -> Result<Vec<DVec2>, CoreError> {
+    let arc = cumulative_lengths(p);
+    match corner_plan(p, &arc, m, min_turn_deg) {
+        None => Ok(resample_arc_length(p, m.max(2))?),
+        Some(nodes) => Ok(nodes.iter().map(|&s| point_at(p, &arc, s)).collect()),
+    }
+}
+
+/// The arc-length positions of the nodes of [`resample_keeping_corners`] (`None`: no corner is
+/// kept, plain arc-length resampling).
+fn corner_plan(p: &[DVec2], arc: &[f64], m: usize, min_turn_deg: f64) -> Option<Vec<f64>> {
     let m = m.max(2);
     let cos_max = min_turn_deg.to_radians().cos();
     // interior vertices by turning angle (sharpest first, ties by position)
@@ -246,8 +256,7 @@ pub fn resample_keeping_corners(
     corners.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     // a kept corner is at least half a mean segment from the ends and from the other kept
     // corners, so no piece gets a segment much shorter than the rest
-    let arc = cumulative_lengths(p);
-    let total = arc[arc.len() - 1];
+    let total = *arc.last()?;
     let gap = 0.5 * total / (m - 1) as f64;
     let mut kept: Vec<usize> = Vec::new();
     for &(_, i) in &corners {
@@ -260,17 +269,16 @@ pub fn resample_keeping_corners(
         }
     }
     if kept.is_empty() {
-        return Ok(resample_arc_length(p, m)?);
+        return None;
     }
-    let mut cuts: Vec<usize> = kept;
-    cuts.sort_unstable();
-    let mut bounds = vec![0];
-    bounds.extend(cuts);
-    bounds.push(p.len() - 1);
-    let pieces: Vec<&[DVec2]> = bounds.windows(2).map(|w| &p[w[0]..=w[1]]).collect();
-    let lengths: Vec<f64> = pieces.iter().map(|q| polyline_length(q)).collect();
+    kept.sort_unstable();
+    let mut bounds = vec![0.0];
+    bounds.extend(kept.iter().map(|&i| arc[i]));
+    bounds.push(total);
+    let lengths: Vec<f64> = bounds.windows(2).map(|w| w[1] - w[0]).collect();
+    let pieces = lengths.len();
     let segs = m - 1;
-    let spare = segs - pieces.len();
+    let spare = segs - pieces;
     let share: Vec<f64> = lengths
         .iter()
         .map(|l| {
@@ -283,26 +291,86 @@ pub fn resample_keeping_corners(
         .collect();
     let mut alloc: Vec<usize> = share.iter().map(|s| 1 + s.floor() as usize).collect();
     let mut left = segs - alloc.iter().sum::<usize>();
-    let mut order: Vec<usize> = (0..pieces.len()).collect();
+    let mut order: Vec<usize> = (0..pieces).collect();
     order.sort_by(|&a, &b| {
         (share[b] - share[b].floor())
             .total_cmp(&(share[a] - share[a].floor()))
             .then(a.cmp(&b))
     });
-    for &i in order.iter().cycle().take(pieces.len() * 2) {
+    for &i in order.iter().cycle().take(pieces * 2) {
         if left == 0 {
             break;
         }
         alloc[i] += 1;
         left -= 1;
     }
-    let mut out: Vec<DVec2> = Vec::with_capacity(m);
-    for (q, &k) in pieces.iter().zip(&alloc) {
-        let pts = resample_arc_length(q, k + 1)?;
-        let skip = usize::from(!out.is_empty());
-        out.extend_from_slice(&pts[skip..]);
+    let mut nodes = vec![0.0];
+    for (i, &k) in alloc.iter().enumerate() {
+        for j in 1..=k {
+            nodes.push(if j == k {
+                bounds[i + 1]
+            } else {
+                bounds[i] + lengths[i] * j as f64 / k as f64
+            });
+        }
     }
-    Ok(out)
+    Some(nodes)
+}
+
+/// The point at arc length `s` of the polyline (`arc` its cumulative lengths).
+fn point_at(p: &[DVec2], arc: &[f64], s: f64) -> DVec2 {
+    let i = arc.partition_point(|&a| a <= s).clamp(1, p.len() - 1);
+    let (a, b) = (arc[i - 1], arc[i]);
+    if b <= a {
+        return p[i];
+    }
+    let t = ((s - a) / (b - a)).clamp(0.0, 1.0);
+    p[i - 1] + (p[i] - p[i - 1]) * t
+}
+
+/// The largest distance of a vertex of `p` from the resampled polyline of `m` points
+/// ([`resample_keeping_corners`] with [`CORNER_TURN_DEG`]): each vertex is measured against the
+/// chord between the two nodes around it.
+pub fn chord_deviation(p: &[DVec2], m: usize) -> f64 {
+    let arc = cumulative_lengths(p);
+    let total = arc.last().copied().unwrap_or(0.0);
+    let nodes: Vec<f64> = corner_plan(p, &arc, m, CORNER_TURN_DEG).unwrap_or_else(|| {
+        let m = m.max(2);
+        (0..m).map(|k| total * k as f64 / (m - 1) as f64).collect()
+    });
+    let mut worst: f64 = 0.0;
+    let mut k = 0;
+    for (i, &v) in p.iter().enumerate() {
+        while k + 2 < nodes.len() && nodes[k + 1] <= arc[i] {
+            k += 1;
+        }
+        let a = point_at(p, &arc, nodes[k]);
+        let b = point_at(p, &arc, nodes[k + 1]);
+        worst = worst.max(unamalla_mesh::geometry::point_segment_distance(v, a, b));
+    }
+    worst
+}
+
+/// Fewest points (≥ 2) whose resampling keeps `p` within `tol` ([`chord_deviation`]), by
+/// bisection between 2 and `hi` (the deviation shrinks as points are added, up to the kept
+/// corners' rounding); `hi` when even that is not enough.
+pub fn points_for_deviation(p: &[DVec2], tol: f64, hi: usize) -> usize {
+    if p.len() <= 2 || chord_deviation(p, 2) <= tol {
+        return 2;
+    }
+    let (mut lo, mut hi) = (2usize, hi.max(3));
+    if chord_deviation(p, hi) > tol {
+        return hi;
+    }
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if chord_deviation(p, mid) <= tol {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
 }
 
 /// The area of the decomposed region: the sum of the block areas.
@@ -321,6 +389,12 @@ pub const BUDGET_ITERATIONS: usize = 8;
 /// collapses to a single edge of a block side (a resolution bound that keeps small islands
 /// meshable).
 pub const HOLE_MIN_POINTS: usize = 3;
+
+/// The resolution bound of the boundary curves: every curve gets at least the points that keep
+/// its resampled polyline within `DEVIATION_FACTOR·h` of the region boundary
+/// ([`points_for_deviation`]), so that a coarse count cannot bridge an inlet or cut across a
+/// thin island with a chord (a cell there would lie outside the region).
+pub const DEVIATION_FACTOR: f64 = 0.25;
 
 /// Relative deviation from the requested cell count above which [`compatible_counts`] explains
 /// which curves force the cells ([`CompatibleCounts::notes`]).
@@ -351,8 +425,9 @@ pub struct CompatibleCounts {
 ///
 /// * [`MeshSize::Cells`]`(N)` and [`MeshSize::CellSize`]`(h)` (request `N = area/h²`): the
 ///   **target fit** [`ilp::solve_fit`] — every curve close to `ℓ_j/h + 1` points, deviations paid
-///   in cells, opposite sides equal, both copies of a cut equal, at least 2 points per curve and
-///   [`HOLE_MIN_POINTS`] on hole boundaries. The predicted count `C(h) = Σ_k (n_b − 1)(n_l − 1)`
+///   in cells, opposite sides equal, both copies of a cut equal, at least 2 points per curve,
+///   [`HOLE_MIN_POINTS`] on hole boundaries and the resolution bound of [`DEVIATION_FACTOR`] on
+///   boundary curves. The predicted count `C(h) = Σ_k (n_b − 1)(n_l − 1)`
 ///   is brought to `N` by rescaling `h ← h·√(C/N)` (cells scale like `h⁻²`) until
 ///   `|C/N − 1| ≤` [`BUDGET_TOLERANCE`] or [`BUDGET_ITERATIONS`] fits were run (the fit closest
 ///   to `N` is kept). Starts at `h = √(area/N)` or the given `h`.
@@ -394,8 +469,14 @@ pub fn compatible_counts(d: &Decomposition, size: MeshSize) -> Result<Compatible
     let fit = |h: f64| -> Result<(ilp::FitTargets, ilp::CompatSolution), CoreError> {
         let mut targets = ilp::FitTargets::for_cell_size(&problem, h)?;
         for (j, m) in targets.minimums.iter_mut().enumerate() {
-            if curves.ring(j).is_some_and(|r| r > 0) {
-                *m = (*m).max(HOLE_MIN_POINTS);
+            if let Some(ring) = curves.ring(j) {
+                if ring > 0 {
+                    *m = (*m).max(HOLE_MIN_POINTS);
+                }
+                // the resolution bound: the mesh boundary within DEVIATION_FACTOR·h
+                let p = &curves.points[j];
+                let hi = 2 * (polyline_length(p) / h).ceil() as usize + 2;
+                *m = (*m).max(points_for_deviation(p, DEVIATION_FACTOR * h, hi));
             }
         }
         let sol = ilp::solve_fit(&problem, &targets, &ilp::FitOptions::default())?;

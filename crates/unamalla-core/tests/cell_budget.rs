@@ -144,3 +144,31 @@ fn resampling_keeps_the_corners_of_a_boundary_curve() {
     let p = resample_keeping_corners(&l, 2, 20.0).unwrap();
     assert_eq!(p, vec![l[0], l[2]]);
 }
+
+#[test]
+fn the_resolution_bound_follows_the_sagitta() {
+    use unamalla_core::curves::{chord_deviation, points_for_deviation};
+    // a half circle of radius 10 as a 100-gon (turns of 1.8°: no corner is kept). m points give
+    // chords over π/(m−1) with sagitta 10·(1 − cos(π/(2(m−1)))): 0.1018 for m = 12, 0.0855 for
+    // m = 13; the 100-gon's vertices sit up to 10·(1 − cos(π/198)) = 0.0013 off the circle, so the
+    // fewest points within 0.1 are 12 or 13
+    let p: Vec<DVec2> = (0..100)
+        .map(|k| {
+            let t = std::f64::consts::PI * k as f64 / 99.0;
+            DVec2::new(10.0 * t.cos(), 10.0 * t.sin())
+        })
+        .collect();
+    let m = points_for_deviation(&p, 0.1, 200);
+    assert!((12..=13).contains(&m), "{m}");
+    assert!(chord_deviation(&p, m) <= 0.1);
+    assert!(chord_deviation(&p, m - 1) > 0.1);
+    // two points: the diameter, 10 away from the top vertex (within the 100-gon's offset)
+    assert!((chord_deviation(&p, 2) - 10.0).abs() < 2e-3);
+    // a straight curve needs 2
+    let line = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(5.0, 0.0),
+        DVec2::new(9.0, 0.0),
+    ];
+    assert_eq!(points_for_deviation(&line, 1e-9, 50), 2);
+}
