@@ -393,8 +393,10 @@ pub const HOLE_MIN_POINTS: usize = 3;
 /// The resolution bound of the boundary curves: every curve gets at least the points that keep
 /// its resampled polyline within `DEVIATION_FACTOR·h` of the region boundary
 /// ([`points_for_deviation`]), so that a coarse count cannot bridge an inlet or cut across a
-/// thin island with a chord (a cell there would lie outside the region).
-pub const DEVIATION_FACTOR: f64 = 0.25;
+/// thin island with a chord (a cell there would lie outside the region). h/4 still left one cell
+/// centroid outside norway-mainland at 5000 cells (a 3-point curve deviating 1.7 = 0.22·h next
+/// to thin cells at a block corner); h/8 is the measured value (docs/results.md, "Cell budget").
+pub const DEVIATION_FACTOR: f64 = 0.125;
 
 /// Relative deviation from the requested cell count above which [`compatible_counts`] explains
 /// which curves force the cells ([`CompatibleCounts::notes`]).
