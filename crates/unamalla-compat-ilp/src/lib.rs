@@ -29,6 +29,15 @@
 //! m_j = pin_j                          (user-pinned curves)
 //! ```
 //!
+//! *Target fit* ([`solve_fit`], module [`fit`]): the same equations, `m_j ≥ max(2, min_j)`, and
+//! `min Σ_j w_j·c(m_j; t_j)` with targets `t_j = ℓ_j/h + 1`, weights `w_j` = the depth of the block
+//! across curve `j` in cells and the convex piecewise-linear deviation cost `c` of [`deviation_cost`]
+//! (slopes 1, 2, 4 within `±t/4`, `±t/2`, beyond). Unlike (5.10) it does not carry the largest
+//! bound of a sheet of blocks across the whole sheet; the pipeline uses it for cell counts and cell
+//! sizes. Solved exactly as a convex-cost min-cost circulation (Ahuja, Magnanti & Orlin 1993, §14.2)
+//! with a reduced-cost optimality certificate ([`Optimality::FitCertified`]), or as a MILP when the
+//! system is not a network.
+//!
 //! *Interval assignment* ILP (3) of seed 002 (digest §5), `min Σ_e n_e/l(e) + M`, `M ≥ n_e/N_e`
 //! ([`assign_intervals`]), and *vertex classification* ILPs (6)/(8) (digest §7–8, Option A reading,
 //! `−2 ≤ α_i ≤ 1`, `Σ α_i = 4(1 − H)`) ([`classify_vertices`]).

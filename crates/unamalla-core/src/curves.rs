@@ -12,7 +12,7 @@ use std::collections::HashMap;
 
 use unamalla_compat_ilp::{self as ilp, CompatProblem};
 use unamalla_decompose::{Decomposition, EdgeKind};
-use unamalla_mesh::resample::{polyline_length, resample_arc_length};
+use unamalla_mesh::resample::{cumulative_lengths, polyline_length, resample_arc_length};
 use unamalla_mesh::{tfi2, DVec2, StructuredGrid2, TfiParams};
 
 use crate::pipeline::MeshSize;
@@ -183,7 +183,7 @@ impl BlockCurves {
                     }
                     v
                 }
-                None => resample_arc_length(p, m)?,
+                None => resample_keeping_corners(p, m, CORNER_TURN_DEG)?,
             };
             sampled.push(pts);
         }
@@ -213,34 +213,361 @@ impl BlockCurves {
     }
 }
 
+/// Turning angle (degrees) above which an interior vertex of a boundary curve is a corner that
+/// the resampling keeps as a node ([`resample_keeping_corners`]).
+pub const CORNER_TURN_DEG: f64 = 20.0;
+
+/// `m ≥ 2` points on the polyline `p`, by arc length, except that the sharpest interior vertices
+/// turning by more than `min_turn_deg` (at most `m − 2` of them) are nodes: the polyline is split
+/// there and its `m − 1` segments are shared among the pieces in proportion to their lengths
+/// (largest remainders, at least one each). Plain arc-length resampling cuts such a corner with a
+/// chord up to a segment long, so the mesh boundary leaves the region there when the counts are
+/// small.
+pub fn resample_keeping_corners(
+    p: &[DVec2],
+    m: usize,
+    min_turn_deg: f64,
+) -> Result<Vec<DVec2>, CoreError> {
+    let arc = cumulative_lengths(p);
+    match corner_plan(p, &arc, m, min_turn_deg) {
+        None => Ok(resample_arc_length(p, m.max(2))?),
+        Some(nodes) => Ok(nodes.iter().map(|&s| point_at(p, &arc, s)).collect()),
+    }
+}
+
+/// The arc-length positions of the nodes of [`resample_keeping_corners`] (`None`: no corner is
+/// kept, plain arc-length resampling).
+fn corner_plan(p: &[DVec2], arc: &[f64], m: usize, min_turn_deg: f64) -> Option<Vec<f64>> {
+    let m = m.max(2);
+    let cos_max = min_turn_deg.to_radians().cos();
+    // interior vertices by turning angle (sharpest first, ties by position)
+    let mut corners: Vec<(f64, usize)> = (1..p.len().saturating_sub(1))
+        .filter_map(|i| {
+            let a = p[i] - p[i - 1];
+            let b = p[i + 1] - p[i];
+            let (la, lb) = (a.length(), b.length());
+            if la == 0.0 || lb == 0.0 {
+                return None;
+            }
+            let c = a.dot(b) / (la * lb);
+            (c < cos_max).then_some((c, i))
+        })
+        .collect();
+    corners.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    // a kept corner is at least half a mean segment from the ends and from the other kept
+    // corners, so no piece gets a segment much shorter than the rest
+    let total = *arc.last()?;
+    let gap = 0.5 * total / (m - 1) as f64;
+    let mut kept: Vec<usize> = Vec::new();
+    for &(_, i) in &corners {
+        if kept.len() + 2 >= m {
+            break;
+        }
+        let far = |a: f64| (arc[i] - a).abs() >= gap;
+        if far(0.0) && far(total) && kept.iter().all(|&k| far(arc[k])) {
+            kept.push(i);
+        }
+    }
+    if kept.is_empty() {
+        return None;
+    }
+    kept.sort_unstable();
+    let mut bounds = vec![0.0];
+    bounds.extend(kept.iter().map(|&i| arc[i]));
+    bounds.push(total);
+    let lengths: Vec<f64> = bounds.windows(2).map(|w| w[1] - w[0]).collect();
+    let pieces = lengths.len();
+    let segs = m - 1;
+    let spare = segs - pieces;
+    let share: Vec<f64> = lengths
+        .iter()
+        .map(|l| {
+            if total > 0.0 {
+                l / total * spare as f64
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut alloc: Vec<usize> = share.iter().map(|s| 1 + s.floor() as usize).collect();
+    let mut left = segs - alloc.iter().sum::<usize>();
+    let mut order: Vec<usize> = (0..pieces).collect();
+    order.sort_by(|&a, &b| {
+        (share[b] - share[b].floor())
+            .total_cmp(&(share[a] - share[a].floor()))
+            .then(a.cmp(&b))
+    });
+    for &i in order.iter().cycle().take(pieces * 2) {
+        if left == 0 {
+            break;
+        }
+        alloc[i] += 1;
+        left -= 1;
+    }
+    let mut nodes = vec![0.0];
+    for (i, &k) in alloc.iter().enumerate() {
+        for j in 1..=k {
+            nodes.push(if j == k {
+                bounds[i + 1]
+            } else {
+                bounds[i] + lengths[i] * j as f64 / k as f64
+            });
+        }
+    }
+    Some(nodes)
+}
+
+/// The point at arc length `s` of the polyline (`arc` its cumulative lengths).
+fn point_at(p: &[DVec2], arc: &[f64], s: f64) -> DVec2 {
+    let i = arc.partition_point(|&a| a <= s).clamp(1, p.len() - 1);
+    let (a, b) = (arc[i - 1], arc[i]);
+    if b <= a {
+        return p[i];
+    }
+    let t = ((s - a) / (b - a)).clamp(0.0, 1.0);
+    p[i - 1] + (p[i] - p[i - 1]) * t
+}
+
+/// The largest distance of a vertex of `p` from the resampled polyline of `m` points
+/// ([`resample_keeping_corners`] with [`CORNER_TURN_DEG`]): each vertex is measured against the
+/// chord between the two nodes around it.
+pub fn chord_deviation(p: &[DVec2], m: usize) -> f64 {
+    let arc = cumulative_lengths(p);
+    let total = arc.last().copied().unwrap_or(0.0);
+    let nodes: Vec<f64> = corner_plan(p, &arc, m, CORNER_TURN_DEG).unwrap_or_else(|| {
+        let m = m.max(2);
+        (0..m).map(|k| total * k as f64 / (m - 1) as f64).collect()
+    });
+    let mut worst: f64 = 0.0;
+    let mut k = 0;
+    for (i, &v) in p.iter().enumerate() {
+        while k + 2 < nodes.len() && nodes[k + 1] <= arc[i] {
+            k += 1;
+        }
+        let a = point_at(p, &arc, nodes[k]);
+        let b = point_at(p, &arc, nodes[k + 1]);
+        worst = worst.max(unamalla_mesh::geometry::point_segment_distance(v, a, b));
+    }
+    worst
+}
+
+/// Fewest points (≥ 2) whose resampling keeps `p` within `tol` ([`chord_deviation`]), by
+/// bisection between 2 and `hi` (the deviation shrinks as points are added, up to the kept
+/// corners' rounding); `hi` when even that is not enough.
+pub fn points_for_deviation(p: &[DVec2], tol: f64, hi: usize) -> usize {
+    if p.len() <= 2 || chord_deviation(p, 2) <= tol {
+        return 2;
+    }
+    let (mut lo, mut hi) = (2usize, hi.max(3));
+    if chord_deviation(p, hi) > tol {
+        return hi;
+    }
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if chord_deviation(p, mid) <= tol {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
 /// The area of the decomposed region: the sum of the block areas.
 pub fn decomposition_area(d: &Decomposition) -> f64 {
     d.blocks.iter().map(|b| b.area()).sum()
 }
 
-/// The compatible point counts of pipeline step 3 for a decomposition and a mesh size
-/// (the region's area, for [`MeshSize::Cells`], is the sum of the block areas): the integer
-/// program (5.10) of `unamalla-compat-ilp` with lower bounds from the cell size
-/// `h = √(area / N)` (or the given `h`, or the density factor `d`). Returns the solution and
-/// the curves it is indexed by.
-pub fn compatible_counts(
-    d: &Decomposition,
-    size: MeshSize,
-) -> Result<(BlockCurves, ilp::CompatSolution), CoreError> {
+/// Relative tolerance of the cell budget loop of [`compatible_counts`]: the cell size is rescaled
+/// until the predicted cell count is within 2 % of the request.
+pub const BUDGET_TOLERANCE: f64 = 0.02;
+
+/// Largest number of target fits of the cell budget loop.
+pub const BUDGET_ITERATIONS: usize = 8;
+
+/// Smallest number of points on a curve of a hole's boundary: two segments, so that no hole
+/// collapses to a single edge of a block side (a resolution bound that keeps small islands
+/// meshable).
+pub const HOLE_MIN_POINTS: usize = 3;
+
+/// The resolution bound of the boundary curves: every curve gets at least the points that keep
+/// its resampled polyline within `DEVIATION_FACTOR·h` of the region boundary
+/// ([`points_for_deviation`]), so that a coarse count cannot bridge an inlet or cut across a
+/// thin island with a chord (a cell there would lie outside the region). h/4 still left one cell
+/// centroid outside norway-mainland at 5000 cells (a 3-point curve deviating 1.7 = 0.22·h next
+/// to thin cells at a block corner); h/8 is the measured value (docs/results.md, "Cell budget").
+pub const DEVIATION_FACTOR: f64 = 0.125;
+
+/// Relative deviation from the requested cell count above which [`compatible_counts`] explains
+/// which curves force the cells ([`CompatibleCounts::notes`]).
+pub const BUDGET_REPORT_TOLERANCE: f64 = 0.15;
+
+/// The result of pipeline step 3 ([`compatible_counts`]).
+#[derive(Debug, Clone)]
+pub struct CompatibleCounts {
+    /// The curves the counts are indexed by.
+    pub curves: BlockCurves,
+    /// The counts (verified by `unamalla-compat-ilp`).
+    pub solution: ilp::CompatSolution,
+    /// The cells the counts make ([`BlockCurves::predicted_cells`]).
+    pub predicted_cells: usize,
+    /// The requested cell count (`N`, or `area/h²` for a cell size `h`); `None` in density mode.
+    pub requested_cells: Option<usize>,
+    /// The cell size of the final target fit (after the budget loop); `None` in density mode.
+    pub cell_size: Option<f64>,
+    /// Target fits run by the budget loop (0 in density mode).
+    pub iterations: usize,
+    /// When the predicted count misses the request by more than [`BUDGET_REPORT_TOLERANCE`]:
+    /// which curves force how many cells.
+    pub notes: Vec<String>,
+}
+
+/// The compatible point counts of pipeline step 3 for a decomposition and a mesh size (the
+/// region's area is the sum of the block areas).
+///
+/// * [`MeshSize::Cells`]`(N)` and [`MeshSize::CellSize`]`(h)` (request `N = area/h²`): the
+///   **target fit** [`ilp::solve_fit`] — every curve close to `ℓ_j/h + 1` points, deviations paid
+///   in cells, opposite sides equal, both copies of a cut equal, at least 2 points per curve,
+///   [`HOLE_MIN_POINTS`] on hole boundaries and the resolution bound of [`DEVIATION_FACTOR`] on
+///   boundary curves. The predicted count `C(h) = Σ_k (n_b − 1)(n_l − 1)`
+///   is brought to `N` by rescaling `h ← h·√(C/N)` (cells scale like `h⁻²`) until
+///   `|C/N − 1| ≤` [`BUDGET_TOLERANCE`] or [`BUDGET_ITERATIONS`] fits were run (the fit closest
+///   to `N` is kept). Starts at `h = √(area/N)` or the given `h`.
+/// * [`MeshSize::Density`]`(d)`: problem (5.10) with the density bounds (seed 000 (5.9)).
+pub fn compatible_counts(d: &Decomposition, size: MeshSize) -> Result<CompatibleCounts, CoreError> {
     let curves = BlockCurves::new(d);
     let problem = curves.problem();
-    let bounds = match size {
-        MeshSize::Cells(n) => {
-            let n = n.max(1) as f64;
-            ilp::LowerBounds::CellSize((decomposition_area(d) / n).sqrt())
+    let area = decomposition_area(d);
+    let (requested, h0) = match size {
+        MeshSize::Density(dens) => {
+            let opts = ilp::SolveOptions::density(dens.max(1));
+            let solution = ilp::solve(&problem, &opts)?;
+            let predicted_cells = curves.predicted_cells(&solution.counts);
+            return Ok(CompatibleCounts {
+                curves,
+                solution,
+                predicted_cells,
+                requested_cells: None,
+                cell_size: None,
+                iterations: 0,
+                notes: Vec::new(),
+            });
         }
-        MeshSize::CellSize(h) => ilp::LowerBounds::CellSize(h),
-        MeshSize::Density(dens) => ilp::LowerBounds::Density(dens.max(1)),
+        MeshSize::Cells(n) => {
+            let n = n.max(1);
+            (n, (area / n as f64).sqrt())
+        }
+        MeshSize::CellSize(h) => {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(ilp::CompatError::InvalidParameter(format!(
+                    "the target cell size must be finite and > 0, got {h}"
+                ))
+                .into());
+            }
+            (((area / (h * h)).round() as usize).max(1), h)
+        }
     };
-    let solve_opts = ilp::SolveOptions {
-        bounds,
-        ..ilp::SolveOptions::default()
+    let want = requested as f64;
+    let fit = |h: f64| -> Result<(ilp::FitTargets, ilp::CompatSolution), CoreError> {
+        let mut targets = ilp::FitTargets::for_cell_size(&problem, h)?;
+        for (j, m) in targets.minimums.iter_mut().enumerate() {
+            if let Some(ring) = curves.ring(j) {
+                if ring > 0 {
+                    *m = (*m).max(HOLE_MIN_POINTS);
+                }
+                // the resolution bound: the mesh boundary within DEVIATION_FACTOR·h
+                let p = &curves.points[j];
+                let hi = 2 * (polyline_length(p) / h).ceil() as usize + 2;
+                *m = (*m).max(points_for_deviation(p, DEVIATION_FACTOR * h, hi));
+            }
+        }
+        let sol = ilp::solve_fit(&problem, &targets, &ilp::FitOptions::default())?;
+        Ok((targets, sol))
     };
-    let counts = ilp::solve(&problem, &solve_opts)?;
-    Ok((curves, counts))
+    let mut h = h0;
+    let mut best: Option<(f64, ilp::FitTargets, ilp::CompatSolution, usize)> = None;
+    let mut iterations = 0;
+    for _ in 0..BUDGET_ITERATIONS {
+        iterations += 1;
+        let (targets, sol) = fit(h)?;
+        let cells = curves.predicted_cells(&sol.counts);
+        let miss = |c: usize| (c as f64 / want - 1.0).abs();
+        if best.as_ref().is_none_or(|b| miss(cells) < miss(b.3)) {
+            best = Some((h, targets, sol, cells));
+        }
+        if miss(cells) <= BUDGET_TOLERANCE || cells == 0 {
+            break;
+        }
+        let next = h * (cells as f64 / want).sqrt();
+        // a fit that no longer changes with h (minimums bind everywhere) ends the loop
+        if !(next.is_finite() && next > 0.0) || (next / h - 1.0).abs() < 1e-6 {
+            break;
+        }
+        h = next;
+    }
+    let Some((h, targets, solution, predicted_cells)) = best else {
+        return Err(CoreError::Unsupported(
+            "no cell budget iteration ran".into(),
+        ));
+    };
+    let mut notes = Vec::new();
+    if (predicted_cells as f64 / want - 1.0).abs() > BUDGET_REPORT_TOLERANCE {
+        notes.push(format!(
+            "the counts give {predicted_cells} cells for {requested} requested \
+             ({:+.0} %, cell size {h:.4e} after {iterations} target fits)",
+            (predicted_cells as f64 / want - 1.0) * 100.0
+        ));
+        notes.extend(forcing_curves(&curves, &targets, &solution.counts, 3));
+    }
+    Ok(CompatibleCounts {
+        curves,
+        solution,
+        predicted_cells,
+        requested_cells: Some(requested),
+        cell_size: Some(h),
+        iterations,
+        notes,
+    })
+}
+
+/// The `top` curves whose counts are farthest above their targets, in cells
+/// (`(m_j − t_j)·w_j/10`, `w_j` the block depth in tenths of cells), described for the report.
+fn forcing_curves(
+    curves: &BlockCurves,
+    targets: &ilp::FitTargets,
+    counts: &[usize],
+    top: usize,
+) -> Vec<String> {
+    let mut excess: Vec<(f64, usize)> = (0..curves.len())
+        .map(|j| {
+            let e = (counts[j] as f64 - targets.targets[j]) * targets.weights[j] as f64 / 10.0;
+            (e, j)
+        })
+        .filter(|&(e, _)| e >= 1.0)
+        .collect();
+    excess.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    excess
+        .into_iter()
+        .take(top)
+        .map(|(e, j)| {
+            let (k, s) = (0..curves.sides.len())
+                .flat_map(|k| (0..4).map(move |s| (k, s)))
+                .find(|&(k, s)| curves.sides[k][s].contains(&j))
+                .unwrap_or((0, 0));
+            let side = ["bottom", "right", "top", "left"][s];
+            let what = match (curves.cut(j), curves.ring(j)) {
+                (Some(c), _) => format!("cut {c}"),
+                (None, Some(0)) => "the outer boundary".to_string(),
+                (None, Some(r)) => format!("the boundary of hole {}", r - 1),
+                (None, None) => "a curve".to_string(),
+            };
+            format!(
+                "curve {j} ({what}, {side} side of block {k}, length {:.4e}) has {} points for a \
+                 target of {:.1}: it forces about {e:.0} cells",
+                polyline_length(&curves.points[j]),
+                counts[j],
+                targets.targets[j]
+            )
+        })
+        .collect()
 }

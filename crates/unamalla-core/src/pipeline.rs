@@ -10,10 +10,12 @@
 //!    admits no convex cells, so such features would leave folded cells behind;
 //! 2. **decompose** into admissible blocks by cuts and choose four corners per block
 //!    (`unamalla-decompose`);
-//! 3. **compatible counts**: every block side is split into curves Q_j (pieces of the original
-//!    boundary or whole cuts); the integer program (5.10) of `unamalla-compat-ilp` gives point
-//!    counts m_j with equal counts on both copies of a cut and on opposite block sides, with
-//!    lower bounds from a target cell size h (default: `h = √(area / 20 000)`);
+//! 3. **compatible counts** ([`crate::curves`]): every block side is split into curves Q_j
+//!    (pieces of the original boundary or whole cuts); point counts m_j with equal counts on both
+//!    copies of a cut and on opposite block sides. For a cell count or cell size: the target fit
+//!    of `unamalla-compat-ilp` (every curve near `ℓ_j/h + 1` points, deviations paid in cells)
+//!    with `h` rescaled until the predicted cell count is within 2 % of the request (default
+//!    20 000 cells); for a density factor: the integer program (5.10) with the bounds (5.9);
 //! 4. **reparametrize** each curve by arc length with m_j points (§4.5) — a cut is resampled
 //!    once and both blocks use the same points;
 //! 5. **TFI** per block (§5.1);
@@ -234,6 +236,10 @@ pub struct MeshReport {
     pub block_quality: Vec<BlockQuality>,
     /// The full quality report of the final mesh.
     pub quality: QualityReport,
+    /// Notes of the pipeline, e.g. which curves force cells when the counts miss the requested
+    /// cell count by more than 15 % ([`crate::curves::CompatibleCounts::notes`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     /// The independent check of the final mesh ([`crate::verify`]).
     pub verification: crate::verify::Verification,
 }
@@ -501,6 +507,8 @@ impl Mesher {
         lap(Stage::Simplify, &mut timer);
 
         // 2–6 by submapping (seed 002) when the strategy asks for it
+        // notes of step 3 for the report (cells the counts cannot avoid)
+        let mut counts_notes: Vec<String> = Vec::new();
         let submapping = match (self.strategy, self.decomposition.is_some()) {
             (Strategy::Submap, true) => {
                 return Err(CoreError::Unsupported(
@@ -571,7 +579,9 @@ impl Mesher {
 
                 // 3. compatible counts
                 self.stage(Stage::Counts, "solving for compatible point counts");
-                let (curves, counts) = crate::curves::compatible_counts(&decomposition, self.size)?;
+                let step3 = crate::curves::compatible_counts(&decomposition, self.size)?;
+                counts_notes = step3.notes;
+                let (curves, counts) = (step3.curves, step3.solution);
                 lap(Stage::Counts, &mut timer);
 
                 // 4–5. reparametrize + TFI
@@ -700,6 +710,7 @@ impl Mesher {
                 .unwrap_or_default(),
             layout: layout_choice,
             quality,
+            notes: counts_notes,
             verification: Default::default(),
         };
         Ok(MeshResult {
