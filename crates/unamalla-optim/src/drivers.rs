@@ -431,7 +431,7 @@ pub fn adaptive_k(
             ..opts.solver.clone()
         };
         let r = minimize_with(&p, x, &so, session, Some(&guard))?;
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             return Ok(report(
                 session,
                 &p,
@@ -482,7 +482,7 @@ pub fn adaptive_k(
         let p = QuadFunctional::new(topo.clone(), combine(f1, f2, w2));
         let r = minimize_with(&p, x, &hom_opts, session, Some(&guard))?;
         last = Some(r);
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             let mut rep = report(session, &p, x, &init, messages, last, -opts.k_star);
             rep.continuation_steps = steps;
             return Ok(rep);
@@ -598,7 +598,7 @@ fn omega_loop<P: Problem>(
         let r = minimize_with(&p, x, &opts.solver, session, guard)?;
         steps += 1;
         last = Some(r);
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             let mut rep = report(session, &p, x, &init, messages, last, eps);
             rep.continuation_steps = steps;
             return Ok(rep);
@@ -725,7 +725,7 @@ pub fn coplanarity_continuation(
         };
         steps += 1;
         last = Some(r);
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             break;
         }
         done |= planar(x);
@@ -871,12 +871,7 @@ pub fn block_smoothing(
         };
         let r = adaptive_k(topo, x, &uo, session)?;
         messages.extend(r.messages.iter().skip(1).copied());
-        if r.status
-            == (Status::Stopped {
-                reason: StopReason::User,
-                convex: r.convex,
-            })
-        {
+        if matches!(r.status, Status::Stopped { reason, .. } if reason.interrupted()) {
             let mut rep = report(session, &probe, x, &init, messages, None, opts.eps);
             rep.status = r.status;
             return Ok(rep);
@@ -905,6 +900,9 @@ pub fn block_smoothing(
         0.0
     };
     let guard = QuadLocalGuard::new(topo.clone());
+    if opts.solver.stop.plateau_alpha > 0.0 {
+        session.set_quality(Some(crate::monitor::quad_mu_share(topo.clone())));
+    }
     let r = if opts.solver.hessian == HessianMode::ProjectedPsd {
         let model = PsdModel::new(&p, PsdProjection::Clamp);
         minimize_with(&model, x, &opts.solver, session, Some(&guard))?
@@ -999,6 +997,12 @@ pub struct SmoothOptions {
     pub iters_per_k: usize,
     /// Maximum `k` updates.
     pub max_k_updates: usize,
+    /// An explicit wall-clock limit of the run in seconds (`None`, the default: the run ends on
+    /// its convergence tests and iteration caps only, so its result does not depend on the
+    /// machine). When it is reached the status says "STOP by TIME LIMIT"
+    /// ([`StopReason::TimeLimit`]).
+    #[serde(default)]
+    pub time_limit: Option<f64>,
 }
 
 impl Default for SmoothOptions {
@@ -1010,6 +1014,7 @@ impl Default for SmoothOptions {
             presmooth: 0,
             iters_per_k: 0,
             max_k_updates: 2000,
+            time_limit: None,
         }
     }
 }
@@ -1052,6 +1057,16 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
     let x0 = x.clone();
     let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
     let mut session = Session::new(&probe, &x, observer);
+    if let Some(t) = opts.time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(OptimError::InvalidOption {
+                name: "time_limit",
+                value: t,
+                reason: "the time limit must be a finite number of seconds ≥ 0",
+            });
+        }
+        session.set_time_limit(Some(Duration::from_secs_f64(t)));
+    }
     let mut rep = match &opts.functional {
         SmoothFunctional::BlockSmoothing {
             sigma,
