@@ -513,10 +513,11 @@ impl Mesher {
         // iterations than the global one, the work is bounded by iteration limits (not
         // wall-clock time, so the result does not depend on the load), and the global run
         // below then starts convex (or nearly so)
-        let patches = crate::untangle::untangle_patches(
+        let patches = crate::untangle::untangle_patches_observed(
             mesh.global_mut(),
             &sopts,
             &crate::untangle::DEFAULT_PATCH_RADII,
+            observer,
         )?;
         if patches.before > 0 {
             mesh.sync_blocks();
@@ -530,6 +531,16 @@ impl Mesher {
                 t_stage.elapsed().as_secs_f64()
             );
             self.stage(Stage::Smooth, &msg);
+            if !patches.unresolved.is_empty() {
+                let msg = format!(
+                    "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
+                    patches.unresolved.len(),
+                    if patches.cancelled { " (cancelled)" } else { "" },
+                    &patches.unresolved[..patches.unresolved.len().min(8)],
+                    if patches.unresolved.len() > 8 { ", …" } else { "" },
+                );
+                self.stage(Stage::Smooth, &msg);
+            }
         }
         // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
         if let Some(t) = self.time_limit {
