@@ -126,6 +126,7 @@ pub struct MeshArgs {
     pub min_hole_area: Option<f64>,
     pub no_simplify: bool,
     pub feature_factor: f64,
+    pub time_limit: Option<f64>,
     pub output: PathBuf,
     pub json: bool,
     pub quiet: bool,
@@ -163,6 +164,12 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
         bail!("--feature-factor must be a number ≥ 0");
     }
     mesher = mesher.feature_factor(a.feature_factor);
+    if let Some(t) = a.time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            bail!("--time-limit must be a number of seconds ≥ 0");
+        }
+    }
+    mesher = mesher.time_limit(a.time_limit);
     mesher = mesher.strategy(match a.strategy.as_str() {
         "submap" => Strategy::Submap,
         "auto" => Strategy::Auto,

@@ -115,6 +115,11 @@ enum Command {
         /// target cell sizes (0 keeps every feature the simplification kept).
         #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_FEATURE_FACTOR)]
         feature_factor: f64,
+        /// Stop smoothing after this many seconds of wall-clock time (status "STOP by TIME
+        /// LIMIT"). By default there is no limit: smoothing stops on convergence, so the mesh
+        /// does not depend on the machine.
+        #[arg(long)]
+        time_limit: Option<f64>,
         /// Output directory.
         #[arg(short, long)]
         output: PathBuf,
@@ -284,6 +289,7 @@ fn run(cli: Cli) -> Result<()> {
             min_hole_area,
             no_simplify,
             feature_factor,
+            time_limit,
             output,
             json,
             quiet,
@@ -299,6 +305,7 @@ fn run(cli: Cli) -> Result<()> {
             min_hole_area,
             no_simplify,
             feature_factor,
+            time_limit,
             output,
             json,
             quiet,

@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! cargo run --release -p unamalla-core --example layout_eval -- \
-//!     [--layout concavity|chords|best] [--aspect T] [--cells N] [--budget S] REGION.geojson…
+//!     [--layout concavity|chords|best] [--aspect T] [--cells N] [--time-limit S] REGION.geojson…
 //! ```
 use unamalla_core::decompose::{DecomposeOptions, Layout};
 use unamalla_core::pipeline::Mesher;
@@ -13,7 +13,7 @@ fn main() {
     let mut layout: Option<Layout> = None;
     let mut aspect = unamalla_core::decompose::chords::DEFAULT_ASPECT;
     let mut cells = 20_000usize;
-    let mut budget = 15.0f64;
+    let mut budget: Option<f64> = None;
     let mut paths = Vec::new();
     let mut predict_only = false;
     let mut args = std::env::args().skip(1);
@@ -29,7 +29,7 @@ fn main() {
             }
             "--aspect" => aspect = val().parse().unwrap_or(aspect),
             "--cells" => cells = val().parse().unwrap_or(cells),
-            "--budget" => budget = val().parse().unwrap_or(budget),
+            "--time-limit" => budget = val().parse().ok(),
             "--predict-only" => predict_only = true,
             _ => paths.push(a),
         }
@@ -80,7 +80,7 @@ fn main() {
         }
         let mut mesher = Mesher::new()
             .cells(cells)
-            .smooth_budget(budget)
+            .time_limit(budget)
             .decompose_options(opts);
         if let Some(l) = layout {
             mesher = mesher.layout(l);
@@ -90,7 +90,7 @@ fn main() {
             Ok(r) => {
                 let rep = &r.report;
                 if std::env::var_os("LAYOUT_SING").is_some() {
-                    use unamalla_core::mesh::{HasNodes, HasQuadCells};
+                    use unamalla_core::mesh::HasNodes;
                     let g = r.mesh.global();
                     let bnd = g.boundary_flags();
                     let mut val = vec![0usize; g.nodes().len()];

@@ -1,4 +1,4 @@
-//! Quick driver: `cargo run --release -p unamalla-core --example mesh_region -- <region.geojson> [cells] [smooth budget s] [feature factor]`.
+//! Quick driver: `cargo run --release -p unamalla-core --example mesh_region -- <region.geojson> [cells] [time limit s] [feature factor]`.
 //! With `UNAMALLA_DIAG=1` it also lists every non-convex cell (block, grid position, the four
 //! angles), to tell folds from flat block corners.
 fn main() {
@@ -6,10 +6,10 @@ fn main() {
     let path = &args[1];
     let cells: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(20_000);
     let region = unamalla_core::io::read_region_geojson(path, Default::default()).unwrap();
-    let budget: f64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(20.0);
+    let limit: Option<f64> = args.get(3).and_then(|s| s.parse().ok());
     let r = unamalla_core::pipeline::Mesher::new()
         .cells(cells)
-        .smooth_budget(budget)
+        .time_limit(limit)
         .feature_factor(
             args.get(4)
                 .and_then(|s| s.parse().ok())

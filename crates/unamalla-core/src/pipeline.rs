@@ -59,7 +59,7 @@ use unamalla_decompose::submap::{prefers_submap, submap, SubmapOptions, Submappi
 use unamalla_decompose::{chord_layout, decompose, DecomposeOptions, Decomposition, Layout};
 use unamalla_mesh::quality::QualityReport;
 use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells, Region};
-use unamalla_optim::monitor::{Control, Monitor, NullObserver, Observer};
+use unamalla_optim::monitor::{NullObserver, Observer};
 use unamalla_optim::{smooth, SmoothOptions};
 
 use crate::CoreError;
@@ -156,7 +156,7 @@ pub struct Mesher {
     decomposition: Option<Decomposition>,
     smooth_opts: SmoothOptions,
     boundary_density: f64,
-    smooth_budget: f64,
+    time_limit: Option<f64>,
     feature_factor: f64,
     flat_corner_deficit: f64,
     progress: Option<ProgressFn>,
@@ -256,7 +256,7 @@ impl Mesher {
             decomposition: None,
             smooth_opts: default_smooth_options(),
             boundary_density: 1.0,
-            smooth_budget: 15.0,
+            time_limit: None,
             feature_factor: DEFAULT_FEATURE_FACTOR,
             flat_corner_deficit: crate::flat_corners::DEFAULT_MIN_DEFICIT_DEG,
             progress: None,
@@ -336,13 +336,15 @@ impl Mesher {
         self.boundary_density = w;
         self
     }
-    /// Wall-time budget of the global smoothing run in seconds (default 15; the local
-    /// untangling before it is bounded by iteration limits instead). Once it is spent and
-    /// the mesh is convex (Inocon = 0) the optimizer is stopped and its current iterate — convex,
-    /// by the safeguard — is kept; a mesh that is still being untangled gets up to three times
-    /// the budget. The report's `smoothing` field then says "STOP by user".
-    pub fn smooth_budget(mut self, seconds: f64) -> Self {
-        self.smooth_budget = seconds;
+    /// An explicit wall-clock limit of the smoothing stage (untangling and the global run) in
+    /// seconds. By default there is none: smoothing ends on its convergence tests and iteration
+    /// caps ([`default_smooth_options`]), so the mesh does not depend on the machine or its
+    /// load. With a limit the optimizer is stopped when it is reached and its current iterate
+    /// is kept (convex, by the safeguard, if it was convex); the report's `smoothing` field then
+    /// says "STOP by TIME LIMIT". A non-finite or negative value is rejected by the smoother
+    /// ([`unamalla_optim::OptimError::InvalidOption`] naming `time_limit`).
+    pub fn time_limit(mut self, seconds: Option<f64>) -> Self {
+        self.time_limit = seconds;
         self
     }
     /// Return a mesh that fails the independent check ([`crate::verify`]) as `Ok`, with the
@@ -610,17 +612,19 @@ impl Mesher {
         {
             *density = self.boundary_density;
         }
-        let budget = self.smooth_budget;
+        // the explicit time limit (if any) counts from the start of the stage
+        let t_stage = Instant::now();
+        sopts.time_limit = self.time_limit;
         // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
         // block boundaries ([`crate::untangle`]): small problems converge in far fewer
         // iterations than the global one, the work is bounded by iteration limits (not
         // wall-clock time, so the result does not depend on the load), and the global run
         // below then starts convex (or nearly so)
-        let t_patch = Instant::now();
-        let patches = crate::untangle::untangle_patches(
+        let patches = crate::untangle::untangle_patches_observed(
             mesh.global_mut(),
             &sopts,
             &crate::untangle::DEFAULT_PATCH_RADII,
+            observer,
         )?;
         if patches.before > 0 {
             mesh.sync_blocks();
@@ -631,24 +635,25 @@ impl Mesher {
                 patches.patches,
                 patches.max_radius,
                 patches.iterations,
-                t_patch.elapsed().as_secs_f64()
+                t_stage.elapsed().as_secs_f64()
             );
             self.stage(Stage::Smooth, &msg);
+            if !patches.unresolved.is_empty() {
+                let msg = format!(
+                    "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
+                    patches.unresolved.len(),
+                    if patches.cancelled { " (cancelled)" } else { "" },
+                    &patches.unresolved[..patches.unresolved.len().min(8)],
+                    if patches.unresolved.len() > 8 { ", …" } else { "" },
+                );
+                self.stage(Stage::Smooth, &msg);
+            }
         }
-        // 7b. the global run; the budget counts from here
-        let started = Instant::now();
-        let mut budgeted = |m: &Monitor| {
-            if observer.observe(m) == Control::Stop {
-                return Control::Stop;
-            }
-            let t = started.elapsed().as_secs_f64();
-            if (t > budget && m.inocon == 0) || t > 3.0 * budget {
-                Control::Stop
-            } else {
-                Control::Continue
-            }
-        };
-        let smoothing = smooth(&mut mesh, &sopts, &mut budgeted)?;
+        // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
+        if let Some(t) = self.time_limit {
+            sopts.time_limit = Some((t - t_stage.elapsed().as_secs_f64()).max(0.0));
+        }
+        let smoothing = smooth(&mut mesh, &sopts, observer)?;
         mesh.sync_blocks();
         lap(Stage::Smooth, &mut timer);
 
@@ -793,16 +798,26 @@ fn nearly_touching(region: &Region, rel: f64) -> bool {
 
 /// The pipeline's smoothing defaults: (6.8) with σ = 0.1 and truncated Newton (trust region)
 /// with the inner CG capped at 40 iterations — on meshes of ~20,000 cells an inexact Newton
-/// step is far cheaper than an exact one and the outer iteration still converges — and at most
-/// 1000 iterations per phase.
+/// step is far cheaper than an exact one and the outer iteration still converges — ended by
+/// the convergence tests [`DEFAULT_STOP_RULES`] and at most 1000 iterations per phase; no
+/// time limit.
 pub fn default_smooth_options() -> SmoothOptions {
     let mut o = SmoothOptions::default();
     o.solver.cg_max_iter = 40;
-    // the time budget ([`Mesher::smooth_budget`]) is the real limit; 200 iterations stopped
-    // the final phase early on most bundled regions
     o.solver.max_iter = 1000;
+    o.solver.stop = DEFAULT_STOP_RULES;
     o
 }
+
+/// The convergence tests of the pipeline's smoothing ([`unamalla_optim::StopRules`]): over a
+/// window of 10 iterations, F decreased by less than 10⁻⁴ relative, or α₋/ᾱ moved by less than
+/// 1 % and the μ ≥ 0.8 share by less than 0.05 points.
+pub const DEFAULT_STOP_RULES: unamalla_optim::StopRules = unamalla_optim::StopRules {
+    window: 10,
+    window_ftol: 1e-4,
+    plateau_alpha: 0.01,
+    plateau_share: 0.05,
+};
 
 fn polygon_area(p: &[DVec2]) -> f64 {
     unamalla_mesh::region::signed_area(p)

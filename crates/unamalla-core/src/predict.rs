@@ -131,8 +131,8 @@ pub fn predict_mesh(d: &Decomposition, size: MeshSize) -> Result<Prediction, Cor
         _ => PREDICT_CELLS,
     };
     let coarse = MeshSize::Cells(n.clamp(1, PREDICT_CELLS));
-    let (curves, counts) = compatible_counts(d, coarse)?;
-    let grids = curves.grids(d, &counts.counts)?;
+    let cc = compatible_counts(d, coarse)?;
+    let grids = cc.curves.grids(d, &cc.solution.counts)?;
     let mut mesh = BlockMesh2::merge(grids, 1e-9)?;
     let singularities = interior_singularities(&mesh);
     laplacian_sweeps(&mut mesh, PREDICT_SWEEPS);

@@ -13,9 +13,24 @@
 //!
 //! Guarantees: only nodes interior to a patch move, and a patch result is copied back only if
 //! it has no more non-convex cells than the patch had (the driver's own contract, checked
-//! again here), so the number of non-convex cells of the mesh never grows. The work is bounded
-//! by iteration limits, not by wall-clock time, so the result does not depend on the machine's
-//! load.
+//! again here), so the number of non-convex cells of the mesh never grows.
+//!
+//! **Bounded work.** Every patch run is capped at [`PATCH_ITERATION_CAP`] solver iterations
+//! (adaptive `k`: at most [`PATCH_K_UPDATES`] updates of 5 iterations, then at most
+//! [`PATCH_POLISH_ITER`] iterations of (6.8)), whatever the caller's smoothing options say, and
+//! one iteration costs O(patch cells). So the work of a radius is at most
+//! `PATCH_ITERATION_CAP × Σ patch cells`, and a patch of radius `r` around `f` folded cells has
+//! at most `f·(2r+1)²` cells in a mesh without interior singularities: the hard bound is
+//! `PATCH_ITERATION_CAP · folded · Σ_r (2r+1)²` cell-iterations ([`PatchReport::work`],
+//! [`PatchReport::work_bound`]). The caps are iteration counts, not wall-clock time, so the
+//! result does not depend on the machine's load.
+//!
+//! **Observable.** [`untangle_patches_observed`] solves the patches in fixed batches of
+//! [`PATCH_BATCH`] (each batch in parallel; patches are disjoint, so the result does not depend
+//! on the batching or the thread count) and calls the observer after every batch with the
+//! iterations so far and the folded cells left; [`Control::Stop`] cancels the rest
+//! ([`PatchReport::cancelled`]). Folds no patch could remove are listed in
+//! [`PatchReport::unresolved`].
 //!
 //! (Beyond the sources: seed 000 smooths block by block and then each block with its
 //! neighbours; local windows around bad cells are standard practice in mesh untangling.)
@@ -23,10 +38,21 @@
 use rayon::prelude::*;
 use unamalla_mesh::quality::non_convex_cells;
 use unamalla_mesh::{DVec2, FreeNodes, HasNodes, HasQuadCells, QuadMesh};
-use unamalla_optim::{smooth, Control, Monitor, OptimError, SmoothOptions};
+use unamalla_optim::{
+    smooth, Control, Monitor, NullObserver, Observer, OptimError, Phase, SmoothOptions,
+};
 
 /// Default patch radii (layers of cells around the folded ones), tried in order.
 pub const DEFAULT_PATCH_RADII: [usize; 5] = [2, 4, 8, 16, 32];
+
+/// Adaptive-`k` updates of a patch run (5 iterations each).
+pub const PATCH_K_UPDATES: usize = 40;
+/// (6.8) iterations of a patch run after its untangling.
+pub const PATCH_POLISH_ITER: usize = 100;
+/// Solver iterations of one patch run at most: `5·PATCH_K_UPDATES + PATCH_POLISH_ITER`.
+pub const PATCH_ITERATION_CAP: usize = 5 * PATCH_K_UPDATES + PATCH_POLISH_ITER;
+/// Patches solved (in parallel) between two observer calls.
+pub const PATCH_BATCH: usize = 16;
 
 /// What [`untangle_patches`] did.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
@@ -41,11 +67,22 @@ pub struct PatchReport {
     pub max_radius: usize,
     /// Solver iterations over all patches.
     pub iterations: usize,
+    /// Work done: Σ over patch runs of iterations × patch cells.
+    pub work: usize,
+    /// The hard bound on [`Self::work`]: [`PATCH_ITERATION_CAP`] × Σ patch cells over the
+    /// radii tried.
+    pub work_bound: usize,
+    /// The observer stopped the untangling (or the time limit was reached).
+    pub cancelled: bool,
+    /// The cells still non-convex at the end (sorted): folds no patch could remove, left to
+    /// the global run.
+    pub unresolved: Vec<usize>,
 }
 
 /// Untangles the non-convex cells of `mesh` by local patches of growing radius (see the module
-/// docs). `opts` are the smoothing options of each patch run (its iteration limits bound the
-/// work); `radii` the patch radii to try in order. Nodes with `is_fixed` stay fixed.
+/// docs). `opts` are the smoothing options of each patch run (its iteration caps are lowered
+/// to [`PATCH_ITERATION_CAP`]); `radii` the patch radii to try in order. Nodes with `is_fixed`
+/// stay fixed.
 pub fn untangle_patches<M>(
     mesh: &mut M,
     opts: &SmoothOptions,
@@ -54,6 +91,30 @@ pub fn untangle_patches<M>(
 where
     M: HasQuadCells + FreeNodes + HasNodes<DVec2> + Sync + ?Sized,
 {
+    untangle_patches_observed(mesh, opts, radii, &mut NullObserver)
+}
+
+/// [`untangle_patches`] reporting to `observer` after every batch of [`PATCH_BATCH`] patches:
+/// the monitor's `iter_homotopic` is the patch iterations so far, `inocon` the folded cells
+/// not yet untangled, `phase` [`Phase::Homotopic`]. [`Control::Stop`] cancels the remaining
+/// patches (the mesh keeps what was solved). An explicit `opts.time_limit` counts from the
+/// call and also cancels.
+pub fn untangle_patches_observed<M>(
+    mesh: &mut M,
+    opts: &SmoothOptions,
+    radii: &[usize],
+    observer: &mut dyn Observer,
+) -> Result<PatchReport, OptimError>
+where
+    M: HasQuadCells + FreeNodes + HasNodes<DVec2> + Sync + ?Sized,
+{
+    let started = std::time::Instant::now();
+    let mut popts = opts.clone();
+    popts.max_k_updates = PATCH_K_UPDATES;
+    popts.iters_per_k = 5;
+    popts.presmooth = 0;
+    popts.solver.max_iter = PATCH_POLISH_ITER;
+    popts.sigma_continuation.clear();
     let mut bad = non_convex_cells(mesh);
     let mut report = PatchReport {
         before: bad.len(),
@@ -140,26 +201,58 @@ where
             patches.push(cells);
         }
         // patches are disjoint (node-sharing components) and only their interior nodes move,
-        // so they are solved in parallel and written back afterwards
-        let view: &M = mesh;
-        let solved: Vec<Result<Option<PatchSolution>, OptimError>> = patches
-            .par_iter()
-            .map(|cells| solve_patch(view, cells, &bad, &comp, &adj, opts))
-            .collect();
-        for s in solved {
-            let Some(s) = s? else { continue };
-            report.patches += 1;
-            report.iterations += s.iterations;
-            if s.improved {
-                let out = mesh.nodes_mut();
-                for (v, p) in s.moved {
-                    out[v] = p;
+        // so a batch is solved in parallel and written back afterwards (in patch order)
+        report.work_bound += PATCH_ITERATION_CAP * patches.iter().map(Vec::len).sum::<usize>();
+        let mut left = bad.len();
+        for batch in patches.chunks(PATCH_BATCH) {
+            if let Some(t) = opts.time_limit {
+                let rest = t - started.elapsed().as_secs_f64();
+                if rest <= 0.0 {
+                    report.cancelled = true;
+                    break;
                 }
+                popts.time_limit = Some(rest);
+            }
+            let view: &M = mesh;
+            let solved: Vec<Result<Option<PatchSolution>, OptimError>> = batch
+                .par_iter()
+                .map(|cells| solve_patch(view, cells, &bad, &comp, &adj, &popts))
+                .collect();
+            for (s, cells) in solved.into_iter().zip(batch) {
+                let Some(s) = s? else { continue };
+                report.patches += 1;
+                report.iterations += s.iterations;
+                report.work += s.iterations * cells.len();
+                left -= s.before;
+                if s.improved {
+                    left += s.after;
+                    let out = mesh.nodes_mut();
+                    for (v, p) in s.moved {
+                        out[v] = p;
+                    }
+                } else {
+                    left += s.before;
+                }
+            }
+            let m = Monitor {
+                inocon: left,
+                iter_homotopic: report.iterations,
+                phase: Phase::Homotopic,
+                elapsed: started.elapsed(),
+                ..Monitor::default()
+            };
+            if observer.observe(&m) == Control::Stop {
+                report.cancelled = true;
+                break;
             }
         }
         bad = non_convex_cells(mesh);
         report.after = bad.len();
+        if report.cancelled {
+            break;
+        }
     }
+    report.unresolved = bad;
     Ok(report)
 }
 
@@ -168,6 +261,8 @@ struct PatchSolution {
     moved: Vec<(usize, DVec2)>,
     improved: bool,
     iterations: usize,
+    before: usize,
+    after: usize,
 }
 
 /// Solves one patch (`cells`, sorted) of `mesh`; `None` if it holds no folded cell or has no
@@ -238,6 +333,8 @@ where
         moved,
         improved: after <= before,
         iterations: res.iter_smooth + res.iter_homotopic + res.iter_classic,
+        before,
+        after,
     }))
 }
 
@@ -312,6 +409,76 @@ mod tests {
             .expect("a negative-area patch is skipped, not an error");
         assert_eq!((r.before, r.after, r.patches), (16, 16, 0));
         assert_eq!(mesh.nodes(), &start[..]);
+    }
+
+    /// 49 × 49 grid with 36 folded spots (a node pushed 1.5 cells diagonally every 8 nodes):
+    /// the untangling finishes within its hard work bound, the observer sees every batch of
+    /// [`PATCH_BATCH`] patches (so at least ⌈36/16⌉ = 3 progress calls) with non-decreasing
+    /// iteration counts, and a stop request at the first call cancels the rest.
+    #[test]
+    fn many_folds_finish_within_the_work_bound_and_report_progress() {
+        let n = 49;
+        let h = 1.0 / (n - 1) as f64;
+        let g = StructuredGrid2::from_fn(n, n, |i, j| DVec2::new(i as f64 * h, j as f64 * h))
+            .expect("grid");
+        let mut mesh = QuadMesh::from_grid(&g);
+        let spots: Vec<(usize, usize)> = (0..6)
+            .flat_map(|a| (0..6).map(move |b| (4 + 8 * a, 4 + 8 * b)))
+            .collect();
+        for &(i, j) in &spots {
+            mesh.nodes_mut()[j * n + i] += DVec2::new(1.5 * h, 1.5 * h);
+        }
+        let mesh0 = mesh.clone();
+        // a node moved to (i+1.5, j+1.5) leaves its SW cell a convex kite and folds the other
+        // three (the NE cell has the node outside, SE and NW turn the wrong way at it)
+        let before = non_convex_cells(&mesh).len();
+        assert_eq!(before, 3 * spots.len());
+        let mut calls: Vec<(usize, usize)> = Vec::new();
+        let mut watch = |m: &Monitor| {
+            calls.push((m.iter_homotopic, m.inocon));
+            Control::Continue
+        };
+        let opts = SmoothOptions::default();
+        let r = untangle_patches_observed(&mut mesh, &opts, &DEFAULT_PATCH_RADII, &mut watch)
+            .expect("untangle");
+        assert_eq!((r.before, r.after), (before, 0), "{r:?}");
+        assert!(r.unresolved.is_empty() && !r.cancelled);
+        assert!(
+            r.patches >= spots.len(),
+            "one patch per spot at least: {r:?}"
+        );
+        // the hard bound: cap × patch cells, and a patch of radius r around f folded cells
+        // has at most f·(2r+1)² cells
+        assert!(r.work <= r.work_bound, "{r:?}");
+        let radii_used: usize = DEFAULT_PATCH_RADII
+            .iter()
+            .take_while(|&&q| q <= r.max_radius)
+            .map(|&q| (2 * q + 1) * (2 * q + 1))
+            .sum();
+        assert!(
+            r.work_bound <= PATCH_ITERATION_CAP * before * radii_used,
+            "{r:?}"
+        );
+        assert!(r.iterations <= r.patches * PATCH_ITERATION_CAP, "{r:?}");
+        assert!(
+            calls.len() >= spots.len().div_ceil(PATCH_BATCH),
+            "{calls:?}"
+        );
+        assert!(calls.windows(2).all(|w| w[0].0 <= w[1].0), "{calls:?}");
+        assert_eq!(
+            calls.last().map(|c| c.1),
+            Some(0),
+            "the last call sees no fold left"
+        );
+
+        // cancelled at the first progress call: one batch solved, the rest left folded
+        let mut mesh = mesh0;
+        let mut stop = |_: &Monitor| Control::Stop;
+        let r = untangle_patches_observed(&mut mesh, &opts, &DEFAULT_PATCH_RADII, &mut stop)
+            .expect("untangle");
+        assert!(r.cancelled && r.patches <= PATCH_BATCH, "{r:?}");
+        assert!(r.after > 0 && r.after < before, "{r:?}");
+        assert_eq!(r.unresolved.len(), r.after);
     }
 
     /// Nothing folded: nothing moves and no patch is solved.

@@ -11,7 +11,6 @@ fn run(region: &Region, h: f64, strategy: Strategy) -> MeshResult {
     Mesher::new()
         .simplify(None)
         .cell_size(h)
-        .smooth_budget(5.0)
         .strategy(strategy)
         .mesh(region)
         .unwrap()

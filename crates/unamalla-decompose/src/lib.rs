@@ -141,6 +141,40 @@
 //! at the same distance). Those inserted corners have 180° by construction (the thesis's rule,
 //! Figs 5.3–5.4); they are the only corners at or above 170°.
 //!
+//! ## Layouts: the concavity layout and the chord layout (issue #22)
+//!
+//! [`Layout::Concavity`] is the algorithm above alone. On long gulfs, elongated islands and
+//! ragged coasts it places long shore-to-shore cuts and cuts *along* elongated parts (sliver
+//! blocks), and leaves narrow arms inside large blocks. [`Layout::Chords`] (module
+//! [`chords`], the default of [`decompose`]) first places cuts chosen from the shape's
+//! **chordal axis** (Prasad, "Morphological analysis of shapes", CNLS Newsletter 139, 1997):
+//! the boundary is sampled (at the cell size, at most a sixteenth of each ring), the samples
+//! are triangulated by a constrained Delaunay triangulation (`spade`), and every interior
+//! edge of it — a chord, a boundary-to-boundary segment inside the region; no two cross — is a
+//! candidate cut:
+//!
+//! 1. **hole bridges**: a minimum spanning tree of the rings over their cheapest chords
+//!    (cost `ℓ·(1 + ḡ)`), closed into cycles by further chords so that no bridge has one block
+//!    on both sides (a second chord of the same hole must leave ≥ ¼ of its perimeter on each
+//!    side); this is what lets a sea with 500 islands decompose
+//!    (`tests/categories.rs` of `unamalla-core`), where Algorithm 2 gives up on a hole;
+//! 2. **transverse cuts**: in each simply connected piece, the chord maximising
+//!    `min(A₁, A₂)/w²·(1 − ½ḡ)` (w its length, A₁, A₂ the areas on its sides — subtree sums of
+//!    the dual tree) is cut while the score reaches the aspect threshold T
+//!    ([`DecomposeOptions::chord_aspect`]): the score is high at **necks** and at the middle of
+//!    long **channels** and elongated islands (which become chains of blocks at most ≈ 2T
+//!    widths long) and low at small capes (a half disc at its base scores π/8);
+//! 3. Algorithm 1 on every piece; then **arm cuts**: a block that still has a part
+//!    [`ARM_SCORE`] chord widths beyond a chord between two boundary points gets that chord as
+//!    a layout cut and the decomposition is redone (two rounds at most).
+//!
+//! Cut ends keep at least [`chords::MIN_END_ANGLE_DEG`] to the boundary and `max(s, w/2)` from
+//! other layout cut ends (no fans). The layout cuts are never merged away. Neither layout
+//! wins everywhere (measured on the 34 development regions with the quality predictor of
+//! `unamalla_core::predict`): the mesher builds the concavity layout and chord layouts at
+//! T = 0.35, 0.75, 1.5 and meshes the one with the best predicted quality
+//! (`unamalla_core::pipeline::choose_layout`).
+//!
 //! ## Submapping (seed 002)
 //!
 //! Module [`submap`] is the second strategy: vertex classification by turning angles with the ILP

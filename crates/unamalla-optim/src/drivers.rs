@@ -431,7 +431,7 @@ pub fn adaptive_k(
             ..opts.solver.clone()
         };
         let r = minimize_with(&p, x, &so, session, Some(&guard))?;
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             return Ok(report(
                 session,
                 &p,
@@ -482,7 +482,7 @@ pub fn adaptive_k(
         let p = QuadFunctional::new(topo.clone(), combine(f1, f2, w2));
         let r = minimize_with(&p, x, &hom_opts, session, Some(&guard))?;
         last = Some(r);
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             let mut rep = report(session, &p, x, &init, messages, last, -opts.k_star);
             rep.continuation_steps = steps;
             return Ok(rep);
@@ -598,7 +598,7 @@ fn omega_loop<P: Problem>(
         let r = minimize_with(&p, x, &opts.solver, session, guard)?;
         steps += 1;
         last = Some(r);
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             let mut rep = report(session, &p, x, &init, messages, last, eps);
             rep.continuation_steps = steps;
             return Ok(rep);
@@ -725,7 +725,7 @@ pub fn coplanarity_continuation(
         };
         steps += 1;
         last = Some(r);
-        if r.reason == StopReason::User {
+        if r.reason.interrupted() {
             break;
         }
         done |= planar(x);
@@ -815,6 +815,12 @@ pub struct BlockSmoothingOptions {
     pub untangle: AdaptiveKOptions,
     /// Solver options of the (6.8) minimization.
     pub solver: SolverOptions,
+    /// σ continuation: before the run at `sigma`, (6.8) is minimized at each of these σ in
+    /// order (e.g. `[1.0]`: the H_ω-dominant, Winslow-type first stage), warm-started, with at
+    /// most `continuation_iter` iterations each and the same stop rules. Empty: none.
+    pub sigma_continuation: Vec<f64>,
+    /// Iteration cap of each σ-continuation stage.
+    pub continuation_iter: usize,
 }
 
 impl Default for BlockSmoothingOptions {
@@ -829,6 +835,8 @@ impl Default for BlockSmoothingOptions {
                 ..AdaptiveKOptions::default()
             },
             solver: SolverOptions::default(),
+            sigma_continuation: Vec::new(),
+            continuation_iter: 50,
         }
     }
 }
@@ -871,12 +879,7 @@ pub fn block_smoothing(
         };
         let r = adaptive_k(topo, x, &uo, session)?;
         messages.extend(r.messages.iter().skip(1).copied());
-        if r.status
-            == (Status::Stopped {
-                reason: StopReason::User,
-                convex: r.convex,
-            })
-        {
+        if matches!(r.status, Status::Stopped { reason, .. } if reason.interrupted()) {
             let mut rep = report(session, &probe, x, &init, messages, None, opts.eps);
             rep.status = r.status;
             return Ok(rep);
@@ -891,10 +894,12 @@ pub fn block_smoothing(
     };
     let omega = opts.eps * ab;
     let h = Kernel2::HOmega(HOmega::new(omega)?).normalized(n, ab)?;
-    let p = QuadFunctional::new(
-        topo.clone(),
-        Kernel2::Combination(vec![(1.0 - opts.sigma, ao), (opts.sigma, h)]),
-    );
+    let functional = |sigma: f64| {
+        QuadFunctional::new(
+            topo.clone(),
+            Kernel2::Combination(vec![(1.0 - sigma, ao.clone()), (sigma, h.clone())]),
+        )
+    };
     session.set_phase(Phase::Classic);
     session.monitor.k_current = None;
     session.monitor.k_old = None;
@@ -905,12 +910,41 @@ pub fn block_smoothing(
         0.0
     };
     let guard = QuadLocalGuard::new(topo.clone());
-    let r = if opts.solver.hessian == HessianMode::ProjectedPsd {
-        let model = PsdModel::new(&p, PsdProjection::Clamp);
-        minimize_with(&model, x, &opts.solver, session, Some(&guard))?
-    } else {
-        minimize_with(&p, x, &opts.solver, session, Some(&guard))?
+    if opts.solver.stop.plateau_alpha > 0.0 {
+        session.set_quality(Some(crate::monitor::quad_mu_share(topo.clone())));
+    }
+    let run = |p: &QuadFunctional<Kernel2>,
+               x: &mut [f64],
+               so: &SolverOptions,
+               session: &mut Session<'_>| {
+        if so.hessian == HessianMode::ProjectedPsd {
+            let model = PsdModel::new(p, PsdProjection::Clamp);
+            minimize_with(&model, x, so, session, Some(&guard))
+        } else {
+            minimize_with(p, x, so, session, Some(&guard))
+        }
     };
+    for &sc in &opts.sigma_continuation {
+        check_sigma("sigma_continuation", sc)?;
+        let so = SolverOptions {
+            max_iter: opts.continuation_iter,
+            ..opts.solver.clone()
+        };
+        let r = run(&functional(sc), x, &so, session)?;
+        if r.reason.interrupted() {
+            break;
+        }
+        // the next stage starts from here: the guard follows the iterate's ε-convexity
+        let c = session.convexity(&probe, x);
+        session.guard_threshold = if c.eps_convex(opts.eps) {
+            opts.eps * ab
+        } else {
+            0.0
+        };
+    }
+    let p = functional(opts.sigma);
+    // (an interrupted continuation returns at once, with the interrupt's reason)
+    let r = run(&p, x, &opts.solver, session)?;
     session.guard_threshold = 0.0;
     let mut rep = report(session, &p, x, &init, messages, Some(r), opts.eps);
     rep.omega = Some(omega);
@@ -999,6 +1033,18 @@ pub struct SmoothOptions {
     pub iters_per_k: usize,
     /// Maximum `k` updates.
     pub max_k_updates: usize,
+    /// An explicit wall-clock limit of the run in seconds (`None`, the default: the run ends on
+    /// its convergence tests and iteration caps only, so its result does not depend on the
+    /// machine). When it is reached the status says "STOP by TIME LIMIT"
+    /// ([`StopReason::TimeLimit`]).
+    #[serde(default)]
+    pub time_limit: Option<f64>,
+    /// σ continuation of the (6.8) driver ([`BlockSmoothingOptions::sigma_continuation`]).
+    #[serde(default)]
+    pub sigma_continuation: Vec<f64>,
+    /// Iteration cap of each σ-continuation stage (0 = 50).
+    #[serde(default)]
+    pub continuation_iter: usize,
 }
 
 impl Default for SmoothOptions {
@@ -1010,6 +1056,9 @@ impl Default for SmoothOptions {
             presmooth: 0,
             iters_per_k: 0,
             max_k_updates: 2000,
+            time_limit: None,
+            sigma_continuation: Vec::new(),
+            continuation_iter: 0,
         }
     }
 }
@@ -1052,6 +1101,16 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
     let x0 = x.clone();
     let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
     let mut session = Session::new(&probe, &x, observer);
+    if let Some(t) = opts.time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(OptimError::InvalidOption {
+                name: "time_limit",
+                value: t,
+                reason: "the time limit must be a finite number of seconds ≥ 0",
+            });
+        }
+        session.set_time_limit(Some(Duration::from_secs_f64(t)));
+    }
     let mut rep = match &opts.functional {
         SmoothFunctional::BlockSmoothing {
             sigma,
@@ -1065,6 +1124,12 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
                 eps: opts.eps,
                 untangle: opts.adaptive(KFunctional::KAreaLength, 0.5, false),
                 solver: opts.solver.clone(),
+                sigma_continuation: opts.sigma_continuation.clone(),
+                continuation_iter: if opts.continuation_iter > 0 {
+                    opts.continuation_iter
+                } else {
+                    50
+                },
             };
             block_smoothing(&topo, &mut x, &bo, &mut session)?
         }

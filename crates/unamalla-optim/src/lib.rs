@@ -60,7 +60,11 @@
 //! ## Stopping and status ([`status`]; seed 001 digest §7.3, Table A.2)
 //! FTOL (relative decrease of F), GTOL (‖g‖ relative to the first gradient, or absolute),
 //! MAXITER, stop by the observer, line-search failures (xtol, rounding, STPMIN, STPMAX, FCN
-//! calls) and trust-radius collapse. [`Status`]'s `Display` prints the UNAMALLA messages.
+//! calls) and trust-radius collapse; beyond Table A.2, the window tests of [`StopRules`]
+//! (relative decrease of F over `W` iterations, quality plateau of α₋/ᾱ and the μ ≥ 0.8
+//! share) and an explicit time limit
+//! ([`Session::set_time_limit`](monitor::Session::set_time_limit), "STOP by TIME LIMIT" —
+//! never a default: without it a run's result does not depend on the machine). [`Status`]'s `Display` prints the UNAMALLA messages.
 //!
 //! ## Observer ([`monitor`]; Table A.1)
 //! Every iteration the observer receives a [`Monitor`]: Alfamin (α₋), ᾱ,
@@ -113,5 +117,7 @@ pub use drivers::{
 pub use error::OptimError;
 pub use linalg::Preconditioner;
 pub use monitor::{Control, Monitor, NullObserver, Observer, Phase, ProgressObserver};
-pub use solver::{minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions};
+pub use solver::{
+    minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions, StopRules,
+};
 pub use status::{LineSearchFailure, Status, StopReason};

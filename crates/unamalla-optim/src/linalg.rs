@@ -7,17 +7,24 @@ use crate::multigrid::{Multigrid, MultigridOptions};
 
 const PAR: usize = 1 << 15;
 
-/// `xᵀy`.
+/// `xᵀy`. Deterministic at any thread count: above the parallel threshold the partial sums
+/// of fixed 8192-element chunks are collected in chunk order and added serially (rayon's own
+/// `sum` groups the partials by its work splitting, which depends on the thread count; see
+/// rayon-rs/rayon#663), and a serial call adds the same partials in the same order.
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
-    if x.len() >= PAR {
-        x.par_chunks(8192)
-            .zip(y.par_chunks(8192))
+    let partials: Vec<f64> = if x.len() >= PAR {
+        x.par_chunks(CHUNK)
+            .zip(y.par_chunks(CHUNK))
             .map(|(a, b)| dot_serial(a, b))
-            .sum()
+            .collect()
     } else {
-        dot_serial(x, y)
-    }
+        return dot_serial(x, y);
+    };
+    partials.iter().sum()
 }
+
+/// The fixed chunk of the parallel reductions (never derived from the thread count).
+const CHUNK: usize = 8192;
 
 fn dot_serial(x: &[f64], y: &[f64]) -> f64 {
     let mut s = [0.0; 4];
@@ -324,4 +331,44 @@ pub(crate) fn inv3_spd(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
         }
     }
     Some(inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The parallel dot product is bit-identical in pools of 1, 2, 3 and 4 threads and equals
+    /// the serial sum of the fixed chunks' partials in chunk order. Magnitudes spread over
+    /// twelve decades make the sum sensitive to its grouping (rayon's own `sum` over the
+    /// chunk partials gave thread-count dependent last bits).
+    #[test]
+    fn dot_is_bit_identical_at_any_thread_count() {
+        let n = 40 * CHUNK + 123;
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let x: Vec<f64> = (0..n)
+            .map(|_| (next() - 0.5) * 10f64.powf(12.0 * next() - 6.0))
+            .collect();
+        let y: Vec<f64> = (0..n).map(|_| next() - 0.3).collect();
+        let expected: f64 = x
+            .chunks(CHUNK)
+            .zip(y.chunks(CHUNK))
+            .map(|(a, b)| dot_serial(a, b))
+            .fold(0.0, |s, p| s + p);
+        for threads in 1..=4 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for _ in 0..5 {
+                let d = pool.install(|| dot(&x, &y));
+                assert_eq!(d.to_bits(), expected.to_bits(), "{threads} threads");
+            }
+        }
+    }
 }

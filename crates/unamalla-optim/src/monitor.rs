@@ -189,6 +189,30 @@ impl Observer for HistoryObserver {
     }
 }
 
+/// A quality measure of the variables for the plateau test: the share (percent) of cells
+/// with μ ≥ 0.8 ([`quad_mu_share`] for quad meshes).
+pub type QualityProbe = std::sync::Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
+
+/// The quality probe of a quad topology: the percentage of cells with μ ≥ 0.8
+/// ([`unamalla_mesh::quality::quad::mu`], the same measure and threshold as the quality
+/// report's good band). Cells are counted, so the value does not depend on the thread count.
+pub fn quad_mu_share(topo: std::sync::Arc<unamalla_functionals::QuadTopology>) -> QualityProbe {
+    std::sync::Arc::new(move |x: &[f64]| {
+        use rayon::prelude::*;
+        let p = topo.node_coords(x);
+        let n = topo.num_cells();
+        let good = (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter(|&c| {
+                let q = topo.cell(c).map(|v| p[v]);
+                unamalla_mesh::quality::quad::mu(&q) >= unamalla_mesh::quality::MU_GOOD
+            })
+            .count();
+        100.0 * good as f64 / n.max(1) as f64
+    })
+}
+
 /// Convexity statistics of an iterate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Convexity {
@@ -248,6 +272,9 @@ pub struct Session<'o> {
     pub guard: bool,
     active_threshold: Option<f64>,
     stop: bool,
+    time_limit: Option<Duration>,
+    timed_out: bool,
+    quality: Option<QualityProbe>,
     pub(crate) hess: Option<unamalla_functionals::Csr>,
     pub(crate) colors: Option<Vec<Vec<usize>>>,
 }
@@ -296,6 +323,9 @@ impl<'o> Session<'o> {
             guard: true,
             active_threshold: None,
             stop: false,
+            time_limit: None,
+            timed_out: false,
+            quality: None,
             hess: None,
             colors: None,
         }
@@ -395,11 +425,7 @@ impl<'o> Session<'o> {
     /// run). Returns the observer's verdict and remembers a stop request.
     pub fn heartbeat(&mut self) -> Control {
         self.monitor.elapsed = self.start.elapsed();
-        let ctl = self.observer.observe(&self.monitor);
-        if ctl == Control::Stop {
-            self.stop = true;
-        }
-        ctl
+        self.control()
     }
 
     /// `true` if `x_trial` keeps every masked element above the threshold.
@@ -537,9 +563,58 @@ impl<'o> Session<'o> {
         self.start.elapsed()
     }
 
-    /// Whether the observer asked to stop.
+    /// Whether the observer asked to stop (or the time limit was reached).
     pub fn stop_requested(&self) -> bool {
         self.stop
+    }
+
+    /// An explicit time limit for the session, counted from its start (`None`: no limit, the
+    /// default — the runs then end on their convergence tests and iteration caps only, so the
+    /// result does not depend on the machine's speed or load). When the limit is reached the
+    /// solver stops with [`StopReason::TimeLimit`](crate::StopReason::TimeLimit).
+    pub fn set_time_limit(&mut self, limit: Option<Duration>) {
+        self.time_limit = limit;
+    }
+
+    /// Whether the time limit stopped the session.
+    pub fn timed_out(&self) -> bool {
+        self.timed_out
+    }
+
+    /// Why an interrupted run stopped: [`StopReason::TimeLimit`](crate::StopReason::TimeLimit)
+    /// if the time limit was reached, else [`StopReason::User`](crate::StopReason::User).
+    pub fn interrupt_reason(&self) -> crate::StopReason {
+        if self.timed_out {
+            crate::StopReason::TimeLimit
+        } else {
+            crate::StopReason::User
+        }
+    }
+
+    /// Sets the quality probe of the plateau test ([`StopRules`](crate::solver::StopRules)):
+    /// a function of the variables returning the share (percent) of cells with μ ≥ 0.8.
+    pub fn set_quality(&mut self, probe: Option<QualityProbe>) {
+        self.quality = probe;
+    }
+
+    /// The quality probe's value at `x` (`None` without a probe).
+    pub fn quality(&self, x: &[f64]) -> Option<f64> {
+        self.quality.as_ref().map(|q| q(x))
+    }
+
+    /// The observer's verdict, overridden by the time limit.
+    fn control(&mut self) -> Control {
+        let mut ctl = self.observer.observe(&self.monitor);
+        if let Some(l) = self.time_limit {
+            if self.start.elapsed() >= l {
+                self.timed_out = true;
+                ctl = Control::Stop;
+            }
+        }
+        if ctl == Control::Stop {
+            self.stop = true;
+        }
+        ctl
     }
 
     /// Records one iteration at `x` with value `f` and gradient norm `gnorm`, notifies the
@@ -558,11 +633,7 @@ impl<'o> Session<'o> {
         }
         let c = self.convexity(problem, x);
         self.update(c, f, gnorm);
-        let ctl = self.observer.observe(&self.monitor);
-        if ctl == Control::Stop {
-            self.stop = true;
-        }
-        (ctl, c)
+        (self.control(), c)
     }
 
     /// Updates the monitor fields without counting an iteration.

@@ -128,6 +128,87 @@ pub struct SolverOptions {
     pub pointwise_mode: PointwiseMode,
     /// Line-search parameters (TN-LS, L-BFGS).
     pub line_search: LineSearchParams,
+    /// Convergence tests over a window of iterations (off by default).
+    #[serde(default)]
+    pub stop: StopRules,
+}
+
+/// Convergence tests over a window of `W` accepted iterations, tested after every accepted
+/// iterate once `W` iterations of the run have been made, and only while the iterate is convex
+/// (a mesh that is still being untangled is never stopped by them). All off with `window = 0`
+/// ([`Default`]).
+///
+/// With `F_k`, `q_k = α₋/ᾱ` and `s_k` the μ ≥ 0.8 share (percent, from the session's
+/// [quality probe](crate::monitor::Session::set_quality)) of iterate `k`:
+/// * **window FTOL** ([`StopReason::WindowFtol`]): `F_{k−W} − F_k ≤ window_ftol·|F_k|` — the
+///   average relative decrease per iteration fell below `window_ftol/W`. Unlike the one-step
+///   FTOL it is not fooled by one short step (a step cut by the safeguard) and it does fire on
+///   a long slow crawl, which the one-step test with a small FTOL never does;
+/// * **quality plateau** ([`StopReason::Plateau`]): over the last `W + 1` iterates
+///   `max q − min q ≤ plateau_alpha·max q` and `max s − min s ≤ plateau_share` — what a user
+///   measures no longer changes even if `F` still creeps down along the flat directions of
+///   `F_AO` (seed 000 (6.8); the diagonal line slides of #4's note). Needs a quality probe;
+///   without one this test is off.
+///
+/// The projected-gradient test is GTOL ([`SolverOptions::gtol`], [`SolverOptions::gtol_abs`]):
+/// the variables are the free nodes only, so the gradient the solvers see is already the
+/// gradient projected onto the feasible set (fixed nodes are equality constraints).
+/// Iteration caps remain [`SolverOptions::max_iter`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StopRules {
+    /// `W`, the window in accepted iterations (0 = every window test off).
+    pub window: usize,
+    /// Relative decrease of `F` over the window below which the run stops (0 = off).
+    pub window_ftol: f64,
+    /// Relative spread of `α₋/ᾱ` over the window below which (with `plateau_share`) the run
+    /// stops (0 = plateau test off).
+    pub plateau_alpha: f64,
+    /// Spread of the μ ≥ 0.8 share (percentage points) over the window below which (with
+    /// `plateau_alpha`) the run stops.
+    pub plateau_share: f64,
+}
+
+impl Default for StopRules {
+    fn default() -> Self {
+        Self {
+            window: 0,
+            window_ftol: 0.0,
+            plateau_alpha: 0.0,
+            plateau_share: 0.0,
+        }
+    }
+}
+
+impl StopRules {
+    /// The test that fires on `hist` (the accepted iterates of the run, oldest first, as
+    /// `(F, α₋/ᾱ, μ-share)`), if any; see the type docs.
+    pub fn check(&self, hist: &[(f64, f64, Option<f64>)]) -> Option<StopReason> {
+        let w = self.window;
+        if w == 0 || hist.len() <= w {
+            return None;
+        }
+        let win = &hist[hist.len() - 1 - w..];
+        let (f_old, f_new) = (win[0].0, win[w].0);
+        if self.window_ftol > 0.0 && f_old - f_new <= self.window_ftol * f_new.abs() {
+            return Some(StopReason::WindowFtol);
+        }
+        if self.plateau_alpha > 0.0 {
+            let spread = |v: &mut dyn Iterator<Item = f64>| {
+                v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x), hi.max(x))
+                })
+            };
+            let (qlo, qhi) = spread(&mut win.iter().map(|h| h.1));
+            let shares: Option<Vec<f64>> = win.iter().map(|h| h.2).collect();
+            if let Some(sh) = shares {
+                let (slo, shi) = spread(&mut sh.into_iter());
+                if qhi - qlo <= self.plateau_alpha * qhi.abs() && shi - slo <= self.plateau_share {
+                    return Some(StopReason::Plateau);
+                }
+            }
+        }
+        None
+    }
 }
 
 impl Default for SolverOptions {
@@ -145,6 +226,7 @@ impl Default for SolverOptions {
             lbfgs_memory: 5,
             pointwise_mode: PointwiseMode::Simultaneous,
             line_search: LineSearchParams::default(),
+            stop: StopRules::default(),
         }
     }
 }
@@ -173,6 +255,9 @@ impl SolverOptions {
         pos("gtol", self.gtol)?;
         pos("gtol_abs", self.gtol_abs)?;
         pos("forcing_max", self.forcing_max)?;
+        pos("stop.window_ftol", self.stop.window_ftol)?;
+        pos("stop.plateau_alpha", self.stop.plateau_alpha)?;
+        pos("stop.plateau_share", self.stop.plateau_share)?;
         if self.lbfgs_memory == 0 {
             return Err(OptimError::InvalidOption {
                 name: "lbfgs_memory",
@@ -325,6 +410,7 @@ pub fn minimize_with<P: Problem + ?Sized>(
         cg: 0,
         cur_min: 0.0,
         alpha_bar: 0.0,
+        history: Vec::new(),
     };
     st.g0norm = st.gnorm;
     let c = session.convexity(problem, x);
@@ -332,7 +418,7 @@ pub fn minimize_with<P: Problem + ?Sized>(
     st.alpha_bar = c.mean;
     session.update(c, f, st.gnorm);
     let reason = if session.stop_requested() {
-        StopReason::User
+        session.interrupt_reason()
     } else if st.gnorm <= opts.gtol_abs || st.gnorm == 0.0 {
         StopReason::Gtol
     } else {
@@ -346,9 +432,9 @@ pub fn minimize_with<P: Problem + ?Sized>(
     };
     // a run without an accepted step never reached the observer: let it see the run (time
     // budgets must be able to stop drivers that call the solver repeatedly)
-    let reason = if st.iterations == 0 && reason != StopReason::User {
+    let reason = if st.iterations == 0 && !reason.interrupted() {
         if session.heartbeat() == Control::Stop {
-            StopReason::User
+            session.interrupt_reason()
         } else {
             reason
         }
@@ -377,6 +463,8 @@ struct State {
     cg: usize,
     cur_min: f64,
     alpha_bar: f64,
+    /// `(F, α₋/ᾱ, μ-share)` of the accepted iterates (only with [`StopRules`] on).
+    history: Vec<(f64, f64, Option<f64>)>,
 }
 
 impl State {
@@ -400,7 +488,7 @@ impl State {
         self.cur_min = c.min;
         self.alpha_bar = c.mean;
         if ctl == Control::Stop {
-            return Some(StopReason::User);
+            return Some(session.interrupt_reason());
         }
         if gnorm <= opts.gtol * self.g0norm || gnorm <= opts.gtol_abs {
             return Some(StopReason::Gtol);
@@ -409,6 +497,26 @@ impl State {
         // says nothing about optimality)
         if !truncated && (f_old - f_new) <= opts.ftol * f_old.abs().max(f_new.abs()) {
             return Some(StopReason::Ftol);
+        }
+        if opts.stop.window > 0 {
+            if c.nonconvex_cells > 0 {
+                // the window tests apply to convex iterates only
+                self.history.clear();
+            } else {
+                let share = if opts.stop.plateau_alpha > 0.0 {
+                    session.quality(x)
+                } else {
+                    None
+                };
+                self.history.push((f_new, c.min / c.mean, share));
+                if let Some(r) = opts.stop.check(&self.history) {
+                    return Some(r);
+                }
+                if self.history.len() > 4 * opts.stop.window {
+                    self.history
+                        .drain(..self.history.len() - opts.stop.window - 1);
+                }
+            }
         }
         if self.iterations >= opts.max_iter {
             return Some(StopReason::MaxIter);

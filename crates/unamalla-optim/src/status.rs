@@ -29,6 +29,17 @@ pub enum StopReason {
     MaxIter,
     /// The observer asked to stop.
     User,
+    /// The explicit time limit of the run ([`Session::set_time_limit`](crate::monitor::Session::set_time_limit),
+    /// `Mesher::time_limit`, `--time-limit`) was reached ("STOP by TIME LIMIT"; never reported
+    /// as "by user").
+    TimeLimit,
+    /// The window test of [`StopRules`](crate::solver::StopRules): `F` decreased by at most
+    /// `window_ftol·|F|` over the last `window` iterations ("STOP by WINDOW FTOL condition").
+    WindowFtol,
+    /// The quality plateau of [`StopRules`](crate::solver::StopRules): α₋/ᾱ and the share of
+    /// cells with μ ≥ 0.8 did not change over the last `window` iterations ("STOP by QUALITY
+    /// PLATEAU").
+    Plateau,
     /// The line search failed.
     LineSearch(LineSearchFailure),
     /// The trust radius collapsed (reported with the "rounding errors" message of Table A.2).
@@ -40,12 +51,23 @@ pub enum StopReason {
 }
 
 impl StopReason {
-    /// `true` for the ideal endings (FTOL, GTOL, and the planarity stop of Algorithm B).
+    /// `true` for the ideal endings (FTOL, GTOL, the window and plateau tests of
+    /// [`StopRules`](crate::solver::StopRules), and the planarity stop of Algorithm B).
     pub fn converged(self) -> bool {
         matches!(
             self,
-            StopReason::Ftol | StopReason::Gtol | StopReason::Planar
+            StopReason::Ftol
+                | StopReason::Gtol
+                | StopReason::Planar
+                | StopReason::WindowFtol
+                | StopReason::Plateau
         )
+    }
+
+    /// `true` when the run was interrupted from outside: by the observer or by the time
+    /// limit. Drivers stop their continuation on it.
+    pub fn interrupted(self) -> bool {
+        matches!(self, StopReason::User | StopReason::TimeLimit)
     }
 }
 
@@ -102,6 +124,14 @@ impl fmt::Display for Status {
                     (StopReason::Planar, false) => "Non convex grid, STOP by PLANARITY condition",
                     (StopReason::User, true) => "Convex grid, STOP by user",
                     (StopReason::User, false) => "Non convex grid, STOP by user",
+                    (StopReason::TimeLimit, true) => "Convex grid, STOP by TIME LIMIT",
+                    (StopReason::TimeLimit, false) => "Non convex grid, STOP by TIME LIMIT",
+                    (StopReason::WindowFtol, true) => "Convex grid, STOP by WINDOW FTOL condition",
+                    (StopReason::WindowFtol, false) => {
+                        "Non convex grid, STOP by WINDOW FTOL condition"
+                    }
+                    (StopReason::Plateau, true) => "Convex grid, STOP by QUALITY PLATEAU",
+                    (StopReason::Plateau, false) => "Non convex grid, STOP by QUALITY PLATEAU",
                     (StopReason::LineSearch(L::Xtol), _) => {
                         "The interval of uncertainty is at mos xtol"
                     }

@@ -1,0 +1,236 @@
+//! The window tests of `StopRules` and the explicit time limit (issue #23 item 1): a run ends
+//! where the rule, applied by hand to the history of a run without it, says it must.
+
+use std::sync::Arc;
+
+use unamalla_functionals::QuadTopology;
+use unamalla_mesh::StructuredGrid2;
+use unamalla_optim::drivers::{smooth, SmoothOptions};
+use unamalla_optim::fixtures::sinusoidal;
+use unamalla_optim::monitor::{quad_mu_share, HistoryObserver, Monitor};
+use unamalla_optim::solver::{SolverOptions, StopRules};
+use unamalla_optim::status::{Status, StopReason};
+
+/// (6.8) σ = 0.1 with TN-TR, every one-step test off (FTOL = GTOL = 0), so only the window
+/// rule (or MAXITER) can end the run.
+fn opts(stop: StopRules, max_iter: usize) -> SmoothOptions {
+    SmoothOptions {
+        solver: SolverOptions {
+            max_iter,
+            ftol: 0.0,
+            gtol: 0.0,
+            cg_max_iter: 40,
+            stop,
+            ..SolverOptions::default()
+        },
+        ..SmoothOptions::default()
+    }
+}
+
+fn grid() -> StructuredGrid2 {
+    sinusoidal(21, 21, 0.08, 2.0).unwrap()
+}
+
+/// The classic-phase monitors of a run (one per accepted iterate).
+fn run(stop: StopRules, max_iter: usize) -> (Vec<Monitor>, Status) {
+    let mut g = grid();
+    let mut h = HistoryObserver::default();
+    let rep = smooth(&mut g, &opts(stop, max_iter), &mut h).unwrap();
+    (h.history, rep.status)
+}
+
+#[test]
+fn window_ftol_stops_where_the_rule_applied_to_the_free_run_says() {
+    let (free, status) = run(StopRules::default(), 60);
+    assert!(
+        !matches!(
+            status,
+            Status::Stopped {
+                reason: StopReason::WindowFtol,
+                ..
+            }
+        ),
+        "without the rule it cannot fire: {status}"
+    );
+    let w = 5;
+    let tol = 1e-4;
+    // first accepted iterate k (1-based) with F_{k−w} − F_k ≤ tol·|F_k| (all iterates are
+    // convex: the start is ε-convex and the safeguard keeps it so)
+    let f: Vec<f64> = free.iter().map(|m| m.f).collect();
+    assert!(free.iter().all(|m| m.inocon == 0));
+    let k = (w..f.len())
+        .find(|&i| f[i - w] - f[i] <= tol * f[i].abs())
+        .expect("the free run must flatten out within 60 iterations")
+        + 1;
+    assert!(
+        k > w + 1,
+        "the rule must not fire at the first chance ({k})"
+    );
+    assert!(k < free.len(), "the free run went on past {k} ({status})");
+    let rule = StopRules {
+        window: w,
+        window_ftol: tol,
+        ..StopRules::default()
+    };
+    let (hist, status) = run(rule, 60);
+    assert_eq!(
+        status,
+        Status::Stopped {
+            reason: StopReason::WindowFtol,
+            convex: true
+        }
+    );
+    assert_eq!(
+        hist.len(),
+        k,
+        "stopped after iterate {k} (derived from the free run)"
+    );
+    // and the iterates up to there are those of the free run
+    for (a, b) in hist.iter().zip(&free) {
+        assert_eq!(a.f, b.f);
+    }
+    assert_eq!(
+        status.to_string(),
+        "Convex grid, STOP by WINDOW FTOL condition"
+    );
+}
+
+#[test]
+fn quality_plateau_stops_where_alpha_and_the_mu_share_stop_moving() {
+    // the free run's α₋/ᾱ per iterate from the monitor, its μ ≥ 0.8 share from the probe at
+    // the iterates (recomputed here by re-running with max_iter = k, which is the same run
+    // cut at k)
+    let n = 30;
+    let (free, _) = run(StopRules::default(), n);
+    let q: Vec<f64> = free.iter().map(|m| m.alfamin / m.alpha_bar).collect();
+    let topo = Arc::new(QuadTopology::from_mesh(&grid()).unwrap());
+    let probe = quad_mu_share(topo.clone());
+    let share: Vec<f64> = (1..=n)
+        .map(|k| {
+            let mut g = grid();
+            smooth(
+                &mut g,
+                &opts(StopRules::default(), k),
+                &mut HistoryObserver::default(),
+            )
+            .unwrap();
+            let t = QuadTopology::from_mesh(&g).unwrap();
+            probe(&t.initial_x())
+        })
+        .collect();
+    let (w, pa, ps) = (4, 0.02, 0.5);
+    let spread = |v: &[f64]| {
+        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - v.iter().cloned().fold(f64::INFINITY, f64::min)
+    };
+    let k = (w..n)
+        .find(|&i| {
+            let qs = &q[i - w..=i];
+            let qmax = qs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            spread(qs) <= pa * qmax && spread(&share[i - w..=i]) <= ps
+        })
+        .expect("the quality must settle within 30 iterations")
+        + 1;
+    assert!(
+        k > w + 1,
+        "the plateau must not be there from the start ({k})"
+    );
+    let rule = StopRules {
+        window: w,
+        plateau_alpha: pa,
+        plateau_share: ps,
+        ..StopRules::default()
+    };
+    let (hist, status) = run(rule, n);
+    assert_eq!(
+        status,
+        Status::Stopped {
+            reason: StopReason::Plateau,
+            convex: true
+        }
+    );
+    assert_eq!(
+        hist.len(),
+        k,
+        "plateau after iterate {k} (derived from the free run)"
+    );
+    assert_eq!(status.to_string(), "Convex grid, STOP by QUALITY PLATEAU");
+}
+
+#[test]
+fn stop_rules_check_by_hand() {
+    let r = StopRules {
+        window: 2,
+        window_ftol: 0.1,
+        plateau_alpha: 0.0,
+        plateau_share: 0.0,
+    };
+    // F: 10, 9, 8.5: over two iterations 1.5 > 0.1·8.5 = 0.85 → go on; then 8.2: 0.8 ≤ 0.82
+    let h = |f: &[f64]| f.iter().map(|&f| (f, 0.1, None)).collect::<Vec<_>>();
+    assert_eq!(r.check(&h(&[10.0, 9.0])), None, "window not full");
+    assert_eq!(r.check(&h(&[10.0, 9.0, 8.5])), None);
+    assert_eq!(
+        r.check(&h(&[10.0, 9.0, 8.5, 8.2])),
+        Some(StopReason::WindowFtol)
+    );
+    let p = StopRules {
+        window: 2,
+        window_ftol: 0.0,
+        plateau_alpha: 0.01,
+        plateau_share: 0.1,
+    };
+    // α₋/ᾱ within 1 % of its max, share within 0.1 points → plateau; a share jump of 0.2 → not
+    let flat = [
+        (5.0, 0.200, Some(90.0)),
+        (4.0, 0.199, Some(90.05)),
+        (3.0, 0.2005, Some(90.1)),
+    ];
+    assert_eq!(p.check(&flat), Some(StopReason::Plateau));
+    let jump = [
+        (5.0, 0.200, Some(90.0)),
+        (4.0, 0.199, Some(90.05)),
+        (3.0, 0.2005, Some(90.2)),
+    ];
+    assert_eq!(p.check(&jump), None);
+    let alpha_moves = [
+        (5.0, 0.200, Some(90.0)),
+        (4.0, 0.21, Some(90.0)),
+        (3.0, 0.2, Some(90.0)),
+    ];
+    assert_eq!(p.check(&alpha_moves), None);
+    // without a quality probe the plateau test cannot fire
+    let no_probe = [(5.0, 0.2, None), (4.0, 0.2, None), (3.0, 0.2, None)];
+    assert_eq!(p.check(&no_probe), None);
+}
+
+#[test]
+fn an_explicit_time_limit_is_its_own_status_never_by_user() {
+    let mut g = grid();
+    let o = SmoothOptions {
+        time_limit: Some(0.0),
+        ..opts(StopRules::default(), 1000)
+    };
+    let rep = smooth(&mut g, &o, &mut HistoryObserver::default()).unwrap();
+    assert_eq!(
+        rep.status,
+        Status::Stopped {
+            reason: StopReason::TimeLimit,
+            convex: true
+        }
+    );
+    assert_eq!(rep.status.to_string(), "Convex grid, STOP by TIME LIMIT");
+    assert!(rep.iterations() <= 1, "{}", rep.iterations());
+    // a bad limit is a typed error naming the option
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let o = SmoothOptions {
+            time_limit: Some(bad),
+            ..opts(StopRules::default(), 10)
+        };
+        match smooth(&mut grid(), &o, &mut HistoryObserver::default()) {
+            Err(unamalla_optim::OptimError::InvalidOption { name, .. }) => {
+                assert_eq!(name, "time_limit")
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+}
