@@ -27,7 +27,7 @@ pub struct HexArgs {
     /// Perturbation amplitude s (each interior node moves up to s × its shortest edge);
     /// 0 for none. Default: the smallest amplitude giving the thesis's number of non-convex
     /// cells at the start (none for the box and for face directories).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub perturb: Option<f64>,
     /// Instead of an amplitude: perturb until at least this many cells are non-convex.
     #[arg(long, conflicts_with = "perturb")]

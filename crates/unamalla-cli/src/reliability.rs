@@ -96,7 +96,9 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         if let Some(c) = cause.downcast_ref::<CoreError>() {
             match c {
                 CoreError::Guarantee(_) => return EXIT_NOT_MET,
-                CoreError::Preflight(PreflightError::TooLarge { .. }) => return EXIT_USAGE,
+                CoreError::Preflight(
+                    PreflightError::TooLarge { .. } | PreflightError::BadLimit(_),
+                ) => return EXIT_USAGE,
                 _ => {}
             }
         }
