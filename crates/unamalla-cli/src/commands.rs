@@ -12,11 +12,92 @@ use unamalla_core::contour::{self, HoleFilter, SimplifyOptions};
 use unamalla_core::decompose::{self as dec, Decomposition};
 use unamalla_core::io::{self, VtkMesh};
 use unamalla_core::mesh::quality::quad_cell_metrics;
-use unamalla_core::mesh::{QuadMesh, Region};
+use unamalla_core::mesh::{HasNodes, QuadMesh, Region};
 use unamalla_core::optim::{self, NullObserver, Observer, ProgressObserver, SmoothOptions};
 use unamalla_core::output::{OutputDir, OutputFiles};
 use unamalla_core::pipeline::{Mesher, Strategy};
 use unamalla_core::render;
+
+/// Input and export options of `unamalla mesh` (issue #26): region formats, feature
+/// selection, coordinate system, solver formats and the HTML report.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SolverGisArgs {
+    /// Coordinate system of the region: auto (GeoJSON in the lon/lat range without declared
+    /// units, or a shapefile with a geographic .prj, is WGS84 lon/lat), lonlat, planar, or a
+    /// proj string ("+proj=utm +zone=33 +datum=WGS84 +units=m"). Geographic input is meshed in
+    /// a local transverse Mercator projection, lengths in km.
+    #[arg(long, default_value = "auto")]
+    pub crs: String,
+    /// Select a feature by attribute, KEY=VALUE (GeoJSON properties, shapefile .dbf fields).
+    #[arg(long)]
+    pub feature: Option<String>,
+    /// Solver formats to write besides the VTK files, comma-separated: msh, su2, openfoam, cgns
+    /// (cgns needs a build with `--features cgns`), or none.
+    #[arg(long, default_value = "msh,su2,openfoam")]
+    pub export: String,
+    /// Thickness of the one-cell OpenFOAM extrusion (default: the mean cell size).
+    #[arg(long)]
+    pub thickness: Option<f64>,
+    /// With projected input: also write mesh-lonlat.msh with the nodes back-projected to
+    /// longitude/latitude.
+    #[arg(long)]
+    pub lonlat: bool,
+    /// Do not write report.html.
+    #[arg(long)]
+    pub no_report: bool,
+}
+
+/// The solver formats `--export` names.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Exports {
+    msh: bool,
+    su2: bool,
+    openfoam: bool,
+    cgns: bool,
+}
+
+fn parse_exports(s: &str) -> Result<Exports> {
+    let mut e = Exports::default();
+    for t in s.split(',').map(str::trim).filter(|t| !t.is_empty()) {
+        match t {
+            "msh" => e.msh = true,
+            "su2" => e.su2 = true,
+            "openfoam" | "foam" => e.openfoam = true,
+            "cgns" if cfg!(feature = "cgns") => e.cgns = true,
+            "cgns" => bail!(
+                "--export cgns needs a build with the CGNS library: cargo build --features cgns"
+            ),
+            "none" => {}
+            other => bail!("--export: unknown format {other:?} (msh, su2, openfoam, cgns, none)"),
+        }
+    }
+    Ok(e)
+}
+
+/// Reads a region of any supported format (see [`io::input`]), printing the notes (unless
+/// `quiet`) and any warning.
+fn load_region(path: &Path, gis: &SolverGisArgs, quiet: bool) -> Result<io::LoadedRegion> {
+    let opts = io::LoadOptions {
+        feature: gis.feature.clone(),
+        crs: gis.crs.parse()?,
+    };
+    let l = io::load_region(path, &opts)?;
+    if !quiet {
+        for n in &l.notes {
+            eprintln!("note: {n}");
+        }
+        if l.removed_points > 0 {
+            eprintln!(
+                "note: removed {} repeated point(s) from the region",
+                l.removed_points
+            );
+        }
+    }
+    if let Some(w) = &l.warning {
+        eprintln!("warning: {w}");
+    }
+    Ok(l)
+}
 
 fn write_text(path: &Path, text: &str) -> Result<()> {
     io::atomic_write(path, |w| w.write_all(text.as_bytes()))
@@ -50,13 +131,19 @@ pub struct MeshArgs {
     pub output: PathBuf,
     pub json: bool,
     pub quiet: bool,
+    pub gis: SolverGisArgs,
 }
 
-/// `unamalla mesh`. A MultiPolygon's parts are meshed one by one into `part-K/` (with a
-/// summary `report.json` listing them) unless `--part` picks one; a single polygon writes
-/// its files into the output directory itself.
+/// `unamalla mesh`. A GeoJSON MultiPolygon's parts are meshed one by one into `part-K/`
+/// (with a summary `report.json` listing them) unless `--part N` picks one (or `--feature`
+/// selects a feature); a single polygon writes its files into the output directory itself.
 pub fn mesh(a: MeshArgs) -> Result<()> {
-    let parts = reliability::read_region_parts(&a.region, a.part, true)?;
+    let exports = parse_exports(&a.gis.export)?;
+    if let Some(t) = a.gis.thickness {
+        if !(t.is_finite() && t > 0.0) {
+            usage!("--thickness must be a positive number");
+        }
+    }
     // option checks before any work
     if let Some(h) = a.cell_size {
         if !(h.is_finite() && h > 0.0) {
@@ -75,6 +162,41 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
             a.strategy
         );
     }
+    // GeoJSON parts (the general loader takes the largest part): every part, or --part N
+    let is_geojson = a
+        .region
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("geojson") || e.eq_ignore_ascii_case("json"));
+    let parts: Vec<(Option<usize>, io::LoadedRegion)> =
+        match (is_geojson && a.gis.feature.is_none(), a.part) {
+            (true, part) => {
+                let parts = reliability::read_region_parts(&a.region, part, true)?;
+                if parts.len() == 1 && part.is_none() {
+                    vec![(None, load_region(&a.region, &a.gis, a.quiet)?)]
+                } else {
+                    let multi = parts.len() > 1;
+                    parts
+                        .into_iter()
+                        .map(|(k, region)| {
+                            let loaded = io::LoadedRegion {
+                                region,
+                                names: Default::default(),
+                                projection: None,
+                                removed_points: 0,
+                                notes: Vec::new(),
+                                warning: None,
+                            };
+                            (multi.then_some(k), loaded)
+                        })
+                        .collect()
+                }
+            }
+            (false, Some(_)) => usage!("--part applies to GeoJSON files without --feature"),
+            (false, None) => vec![(None, load_region(&a.region, &a.gis, a.quiet)?)],
+        };
+    if a.gis.lonlat && parts.iter().any(|(_, l)| l.projection.is_none()) {
+        usage!("--lonlat needs geographic input (or --crs lonlat / a proj string)");
+    }
     let out = OutputDir::create(&a.output)?;
     let stem = a
         .region
@@ -84,18 +206,12 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     let multi = parts.len() > 1;
     let mut summaries = Vec::new();
     let mut not_met = Vec::new();
-    for (k, region) in &parts {
-        let dir = if multi {
-            out.join(format!("part-{k}"))
-        } else {
-            out.path().to_path_buf()
+    for (k, loaded) in &parts {
+        let (dir, name) = match k {
+            Some(k) => (out.join(format!("part-{k}")), format!("{stem} part {k}")),
+            None => (out.path().to_path_buf(), stem.clone()),
         };
-        let name = if multi {
-            format!("{stem} part {k}")
-        } else {
-            stem.clone()
-        };
-        let (report, warn) = mesh_part(&a, region, &name, &dir, &out)?;
+        let (report, warn) = mesh_part(&a, exports, loaded, &name, &dir, multi)?;
         if let Some(w) = warn {
             not_met.push(w);
         }
@@ -122,15 +238,17 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     reliability::finish((!not_met.is_empty()).then(|| not_met.join("; ")))
 }
 
-/// Meshes one region part into `dir` (inside the staging directory `out`); returns the report
-/// as JSON and the warning when the guarantee is not met (`--allow-non-convex`).
+/// Meshes one region into `dir` (inside the staging directory); returns the report as JSON and
+/// the warning when the guarantee is not met (`--allow-non-convex`).
 fn mesh_part(
     a: &MeshArgs,
-    region: &Region,
+    exports: Exports,
+    loaded: &io::LoadedRegion,
     name: &str,
     dir: &Path,
-    out: &OutputDir,
+    multi: bool,
 ) -> Result<(serde_json::Value, Option<String>)> {
+    let region = loaded.region.clone();
     let mut mesher = Mesher::new();
     mesher = match (a.cells, a.density, a.cell_size) {
         (_, _, Some(h)) => mesher.cell_size(h),
@@ -154,7 +272,7 @@ fn mesh_part(
     if let Some(f) = &a.decomposition {
         // a saved decomposition fits the region without small features; one made by hand for
         // the simplified region (`unamalla simplify`) fits that one
-        let prepared = mesher.prepare_region(region)?;
+        let prepared = mesher.prepare_region(&region)?;
         let (d, _) = read_decomposition(
             f,
             ("the meshed region", &prepared.mesh_region),
@@ -168,12 +286,12 @@ fn mesh_part(
     let mut progress = ProgressObserver::new(Duration::from_millis(200));
     let mut null = NullObserver;
     let observer: &mut dyn Observer = if a.quiet { &mut null } else { &mut progress };
-    let result = mesher.mesh_observed(region, observer);
+    let result = mesher.mesh_observed(&region, observer);
     if !a.quiet {
         progress.finish();
     }
     let result = result.with_context(|| format!("{name}: nothing written"))?;
-    let mut report = result.report;
+    let mut report = result.report.clone();
     report.region = name.to_string();
     let not_met = reliability::guarantee(&report.verification, true, name)?;
 
@@ -193,8 +311,36 @@ fn mesh_part(
         let block_slices: Vec<&[(&str, &[f64])]> =
             block_refs.iter().map(|v| v.as_slice()).collect();
         io::write_block_mesh(dir, mesh, &block_slices, &global)?;
-        let groups = io::msh::boundary_edge_groups(mesh.global());
-        io::write_msh_quads(dir.join("mesh.msh"), mesh.global(), "domain", &groups)?;
+        let groups = if loaded.names.is_empty() {
+            io::msh::boundary_edge_groups(mesh.global())
+        } else {
+            io::named_edge_groups(mesh.global(), &region, &loaded.names)?
+        };
+        if exports.msh {
+            io::write_msh_blocks(dir.join("mesh.msh"), mesh, "domain", &groups)?;
+        }
+        if exports.su2 {
+            io::write_su2(dir.join("mesh.su2"), mesh.global(), &groups)?;
+        }
+        let cell_size = (region.area() / report.cells.max(1) as f64).sqrt();
+        if exports.openfoam {
+            let t = a.gis.thickness.unwrap_or(cell_size);
+            io::write_openfoam(dir.join("openfoam"), mesh.global(), &groups, t)?;
+        }
+        #[cfg(feature = "cgns")]
+        if exports.cgns {
+            unamalla_io::cgns::write_cgns(dir.join("mesh.cgns"), mesh, &groups)?;
+        }
+        if let (true, Some(p)) = (a.gis.lonlat, &loaded.projection) {
+            let g = mesh.global();
+            let ll = g
+                .nodes()
+                .iter()
+                .map(|&q| p.inverse(q))
+                .collect::<Result<Vec<_>, _>>()?;
+            let back = QuadMesh::new(ll, g.cells().to_vec())?;
+            io::write_msh_quads(dir.join("mesh-lonlat.msh"), &back, "domain", &groups)?;
+        }
         write_text(
             &dir.join("decomposition.json"),
             &result.decomposition.to_json(),
@@ -212,10 +358,14 @@ fn mesh_part(
             &render::quality_png(mesh.global(), Some(&result.simplified), 1600)?,
         )?;
         write_text(&dir.join("report.json"), &json)?;
+        if !a.gis.no_report {
+            let settings = crate::report::Settings::of_run(a, loaded, &groups);
+            let html = crate::report::report_html(&result, &report, &settings);
+            write_text(&dir.join("report.html"), &html)?;
+        }
         Ok(())
     })?;
-    let _ = out;
-    if a.json && dir == out.path() {
+    if a.json && !multi {
         println!("{json}");
     } else if !a.quiet {
         println!(
@@ -233,6 +383,52 @@ fn mesh_part(
         );
     }
     Ok((serde_json::to_value(&report)?, not_met))
+}
+
+/// Reads a mesh file of any format `unamalla mesh` writes: VTK legacy (`.vtk`), VTK XML
+/// (`.vtu`, `.vts`; `.vtm`: the blocks it lists merged into one quad mesh) or Gmsh (`.msh`).
+pub fn read_any_mesh(path: &Path) -> Result<io::VtkFile> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    Ok(match ext.as_str() {
+        "vtu" | "vts" => io::read_vtk_xml(path)?,
+        "vtm" => {
+            let dir = path.parent().unwrap_or(Path::new("."));
+            let mut nodes = Vec::new();
+            let mut cells = Vec::new();
+            for e in io::read_vtm(path)? {
+                let f = io::read_vtk_xml(dir.join(&e.file))?;
+                let q = match f.mesh {
+                    VtkMesh::Structured2(g) => QuadMesh::from_grid(&g),
+                    VtkMesh::Quads(q) => q,
+                    _ => bail!("{}: block {} is not a quad mesh", path.display(), e.name),
+                };
+                let off = nodes.len();
+                nodes.extend_from_slice(q.nodes());
+                cells.extend(q.cells().iter().map(|c| c.map(|v| v + off)));
+            }
+            bare_file(VtkMesh::Quads(QuadMesh::new(nodes, cells)?))
+        }
+        "msh" => {
+            let f = io::read_msh(path)?;
+            bare_file(match f.mesh {
+                io::MshMesh::Quads(q) => VtkMesh::Quads(q),
+                io::MshMesh::Hexes(h) => VtkMesh::Hexes(h),
+            })
+        }
+        _ => io::read_vtk(path)?,
+    })
+}
+
+fn bare_file(mesh: VtkMesh) -> io::VtkFile {
+    io::VtkFile {
+        title: String::new(),
+        mesh,
+        cell_data: Vec::new(),
+        point_data: Vec::new(),
+    }
 }
 
 fn read_quad_mesh(path: &Path) -> Result<QuadMesh> {
