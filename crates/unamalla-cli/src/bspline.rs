@@ -30,7 +30,7 @@ use unamalla_core::bspline::{
     ControlNet, Degree, InteriorOptions, TensorMap,
 };
 use unamalla_core::bspline_maps::{block_maps, BlockMapOptions};
-use unamalla_core::io::{self, PartSelector};
+use unamalla_core::io;
 use unamalla_core::pipeline::Mesher;
 use unamalla_core::single_block::{resolve_corners, Corners};
 
@@ -143,19 +143,25 @@ fn write_map_files(dir: &Path, prefix: &str, map: &TensorMap) -> Result<()> {
 pub fn run(a: BsplineArgs) -> Result<()> {
     let t0 = Instant::now();
     if !(2..=100_000).contains(&a.samples) {
-        bail!("--samples must be between 2 and 100000 per direction");
+        crate::reliability::usage!("--samples must be between 2 and 100000 per direction");
     }
     let degree = Degree::from_degree(a.degree as usize)?;
-    let (region, removed) = io::read_region_geojson_cleaned(&a.region, PartSelector::Largest)?;
-    if removed > 0 && !a.quiet {
-        eprintln!("note: removed {removed} repeated point(s) from the region");
-    }
+    let (n, m) = a.net;
+    unamalla_core::preflight::check_size(
+        "--net",
+        format!("{n}x{m}"),
+        n as f64 * m as f64,
+        "control points",
+        unamalla_core::preflight::COST_PER_BSPLINE_NET_POINT,
+        crate::reliability::limit()?,
+    )?;
+    let region = crate::reliability::read_one_region(&a.region, None)?;
+    let out = unamalla_core::output::OutputDir::create(&a.output)?;
     let name = a
         .region
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (n, m) = a.net;
     let report = if a.blocks {
         let cells = a.cells.unwrap_or(n * m);
         if !a.quiet {
@@ -220,8 +226,6 @@ pub fn run(a: BsplineArgs) -> Result<()> {
             "certified": certified_all,
             "seconds": t0.elapsed().as_secs_f64(),
         });
-        std::fs::create_dir_all(&a.output)
-            .with_context(|| format!("creating {}", a.output.display()))?;
         for (k, g) in result.mesh.blocks().iter().enumerate() {
             let net = ControlNet::from_grid(g);
             let map = if degree == Degree::Biquadratic && (g.m() < 3 || g.n() < 3) {
@@ -229,7 +233,9 @@ pub fn run(a: BsplineArgs) -> Result<()> {
             } else {
                 TensorMap::new(degree, net)?
             };
-            write_map_files(&a.output, &format!("block-{k}-"), &map)?;
+            crate::commands::writing(&a.output, || {
+                write_map_files(out.path(), &format!("block-{k}-"), &map)
+            })?;
         }
         report
     } else {
@@ -287,14 +293,13 @@ pub fn run(a: BsplineArgs) -> Result<()> {
             "certificates": serde_json::to_value(&cert)?,
             "seconds": t0.elapsed().as_secs_f64(),
         });
-        std::fs::create_dir_all(&a.output)
-            .with_context(|| format!("creating {}", a.output.display()))?;
-        write_map_files(&a.output, "", &map)?;
+        crate::commands::writing(&a.output, || write_map_files(out.path(), "", &map))?;
         report
     };
     let text = serde_json::to_string_pretty(&report)?;
-    write_with(&a.output.join("report.json"), |w| {
-        w.write_all(text.as_bytes())
+    crate::commands::writing(&a.output, || {
+        write_with(&out.join("report.json"), |w| w.write_all(text.as_bytes()))?;
+        Ok(out.commit()?)
     })?;
     if a.json {
         println!("{text}");

@@ -1,27 +1,22 @@
 //! The subcommands built on the stage crates (`mesh`, `eval`, `smooth`, `simplify`,
-//! `decompose`). Every output file is written atomically, and nothing is written before the
-//! whole computation has succeeded.
+//! `decompose`). Nothing is written before the whole computation has succeeded and passed its
+//! check; the files of a run are staged and moved into place together
+//! ([`unamalla_core::output`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use crate::reliability::{self, usage, PartArg, WriteFailed};
 use anyhow::{bail, Context, Result};
 use unamalla_core::contour::{self, HoleFilter, SimplifyOptions};
 use unamalla_core::decompose::{self as dec, Decomposition};
-use unamalla_core::io::{self, PartSelector, VtkMesh};
+use unamalla_core::io::{self, VtkMesh};
 use unamalla_core::mesh::quality::quad_cell_metrics;
 use unamalla_core::mesh::{HasNodes, QuadMesh, Region};
 use unamalla_core::optim::{self, NullObserver, Observer, ProgressObserver, SmoothOptions};
+use unamalla_core::output::{OutputDir, OutputFiles};
 use unamalla_core::pipeline::{Mesher, Strategy};
 use unamalla_core::render;
-
-fn read_region(path: &Path) -> Result<Region> {
-    let (r, removed) = io::read_region_geojson_cleaned(path, PartSelector::Largest)?;
-    if removed > 0 {
-        eprintln!("note: removed {removed} repeated point(s) from the region");
-    }
-    Ok(r)
-}
 
 /// Input and export options of `unamalla mesh` (issue #26): region formats, feature
 /// selection, coordinate system, solver formats and the HTML report.
@@ -114,6 +109,11 @@ fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// Runs the write phase `f`; a failure is marked as a write failure (exit code 4) naming `target`.
+pub fn writing<T>(target: &Path, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    f().context(WriteFailed(format!("writing {}", target.display())))
+}
+
 /// Arguments of `unamalla mesh`.
 pub struct MeshArgs {
     pub region: PathBuf,
@@ -127,42 +127,137 @@ pub struct MeshArgs {
     pub no_simplify: bool,
     pub feature_factor: f64,
     pub time_limit: Option<f64>,
+    pub part: Option<PartArg>,
+    pub allow_non_convex: bool,
     pub output: PathBuf,
     pub json: bool,
     pub quiet: bool,
     pub gis: SolverGisArgs,
 }
 
-/// `unamalla mesh`.
+/// `unamalla mesh`. A GeoJSON MultiPolygon's parts are meshed one by one into `part-K/`
+/// (with a summary `report.json` listing them) unless `--part N` picks one (or `--feature`
+/// selects a feature); a single polygon writes its files into the output directory itself.
 pub fn mesh(a: MeshArgs) -> Result<()> {
     let exports = parse_exports(&a.gis.export)?;
     if let Some(t) = a.gis.thickness {
         if !(t.is_finite() && t > 0.0) {
-            bail!("--thickness must be a positive number");
+            usage!("--thickness must be a positive number");
         }
     }
-    let loaded = load_region(&a.region, &a.gis, a.quiet)?;
-    if a.gis.lonlat && loaded.projection.is_none() {
-        bail!("--lonlat needs geographic input (or --crs lonlat / a proj string)");
+    // option checks before any work
+    if let Some(h) = a.cell_size {
+        if !(h.is_finite() && h > 0.0) {
+            usage!("--cell-size must be a positive number, got {h}");
+        }
     }
+    if !(a.boundary_density.is_finite() && a.boundary_density >= 1.0) {
+        usage!("--boundary-density must be a number ≥ 1");
+    }
+    if !(a.feature_factor.is_finite() && a.feature_factor >= 0.0) {
+        usage!("--feature-factor must be a number ≥ 0");
+    }
+    if !matches!(a.strategy.as_str(), "cuts" | "submap" | "auto") {
+        usage!(
+            "--strategy must be cuts, submap or auto, got {}",
+            a.strategy
+        );
+    }
+    // GeoJSON parts (the general loader takes the largest part): every part, or --part N
+    let is_geojson = a
+        .region
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("geojson") || e.eq_ignore_ascii_case("json"));
+    let parts: Vec<(Option<usize>, io::LoadedRegion)> =
+        match (is_geojson && a.gis.feature.is_none(), a.part) {
+            (true, part) => {
+                let parts = reliability::read_region_parts(&a.region, part, true)?;
+                if parts.len() == 1 && part.is_none() {
+                    vec![(None, load_region(&a.region, &a.gis, a.quiet)?)]
+                } else {
+                    let multi = parts.len() > 1;
+                    parts
+                        .into_iter()
+                        .map(|(k, region)| {
+                            let loaded = io::LoadedRegion {
+                                region,
+                                names: Default::default(),
+                                projection: None,
+                                removed_points: 0,
+                                notes: Vec::new(),
+                                warning: None,
+                            };
+                            (multi.then_some(k), loaded)
+                        })
+                        .collect()
+                }
+            }
+            (false, Some(_)) => usage!("--part applies to GeoJSON files without --feature"),
+            (false, None) => vec![(None, load_region(&a.region, &a.gis, a.quiet)?)],
+        };
+    if a.gis.lonlat && parts.iter().any(|(_, l)| l.projection.is_none()) {
+        usage!("--lonlat needs geographic input (or --crs lonlat / a proj string)");
+    }
+    let out = OutputDir::create(&a.output)?;
+    let stem = a
+        .region
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let multi = parts.len() > 1;
+    let mut summaries = Vec::new();
+    let mut not_met = Vec::new();
+    for (k, loaded) in &parts {
+        let (dir, name) = match k {
+            Some(k) => (out.join(format!("part-{k}")), format!("{stem} part {k}")),
+            None => (out.path().to_path_buf(), stem.clone()),
+        };
+        let (report, warn) = mesh_part(&a, exports, loaded, &name, &dir, multi)?;
+        if let Some(w) = warn {
+            not_met.push(w);
+        }
+        summaries.push(report);
+    }
+    if multi {
+        let cells: u64 = summaries
+            .iter()
+            .map(|r| r["cells"].as_u64().unwrap_or(0))
+            .sum();
+        let summary = serde_json::json!({
+            "region": stem,
+            "parts": summaries.len(),
+            "cells": cells,
+            "part_reports": summaries,
+        });
+        let text = serde_json::to_string_pretty(&summary)?;
+        writing(&a.output, || write_text(&out.join("report.json"), &text))?;
+        if a.json {
+            println!("{text}");
+        }
+    }
+    writing(&a.output, || Ok(out.commit()?))?;
+    reliability::finish((!not_met.is_empty()).then(|| not_met.join("; ")))
+}
+
+/// Meshes one region into `dir` (inside the staging directory); returns the report as JSON and
+/// the warning when the guarantee is not met (`--allow-non-convex`).
+fn mesh_part(
+    a: &MeshArgs,
+    exports: Exports,
+    loaded: &io::LoadedRegion,
+    name: &str,
+    dir: &Path,
+    multi: bool,
+) -> Result<(serde_json::Value, Option<String>)> {
     let region = loaded.region.clone();
     let mut mesher = Mesher::new();
     mesher = match (a.cells, a.density, a.cell_size) {
-        (_, _, Some(h)) if !(h.is_finite() && h > 0.0) => {
-            bail!("--cell-size must be a positive number")
-        }
         (_, _, Some(h)) => mesher.cell_size(h),
         (_, Some(d), _) => mesher.density(d),
         (Some(n), _, _) => mesher.cells(n),
         _ => mesher,
     };
-    if !(a.boundary_density.is_finite() && a.boundary_density >= 1.0) {
-        bail!("--boundary-density must be a number ≥ 1");
-    }
     mesher = mesher.boundary_density(a.boundary_density);
-    if !(a.feature_factor.is_finite() && a.feature_factor >= 0.0) {
-        bail!("--feature-factor must be a number ≥ 0");
-    }
     mesher = mesher.feature_factor(a.feature_factor);
     if let Some(t) = a.time_limit {
         if !(t.is_finite() && t >= 0.0) {
@@ -173,9 +268,9 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     mesher = mesher.strategy(match a.strategy.as_str() {
         "submap" => Strategy::Submap,
         "auto" => Strategy::Auto,
-        "cuts" => Strategy::Cuts,
-        other => bail!("--strategy must be cuts, submap or auto, got {other}"),
+        _ => Strategy::Cuts,
     });
+    mesher = mesher.allow_non_convex(a.allow_non_convex);
     let mut sopts = SimplifyOptions::default();
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);
@@ -202,82 +297,82 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     if !a.quiet {
         progress.finish();
     }
-    let result = result?;
+    let result = result.with_context(|| format!("{name}: nothing written"))?;
     let mut report = result.report.clone();
-    report.region = a
-        .region
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    report.region = name.to_string();
+    let not_met = reliability::guarantee(&report.verification, true, name)?;
 
-    // everything computed: now write
-    std::fs::create_dir_all(&a.output)
-        .with_context(|| format!("creating {}", a.output.display()))?;
+    // everything computed: now write (into the staging directory)
     let mesh = &result.mesh;
-    let arrays = quad_cell_metrics(mesh.global());
-    let global: Vec<(&str, &[f64])> = arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
-    let block_arrays: Vec<Vec<(&'static str, Vec<f64>)>> =
-        mesh.blocks().iter().map(quad_cell_metrics).collect();
-    let block_refs: Vec<Vec<(&str, &[f64])>> = block_arrays
-        .iter()
-        .map(|b| b.iter().map(|(k, v)| (*k, v.as_slice())).collect())
-        .collect();
-    let block_slices: Vec<&[(&str, &[f64])]> = block_refs.iter().map(|v| v.as_slice()).collect();
-    io::write_block_mesh(&a.output, mesh, &block_slices, &global)?;
-    let groups = if loaded.names.is_empty() {
-        io::msh::boundary_edge_groups(mesh.global())
-    } else {
-        io::named_edge_groups(mesh.global(), &region, &loaded.names)?
-    };
-    if exports.msh {
-        io::write_msh_blocks(a.output.join("mesh.msh"), mesh, "domain", &groups)?;
-    }
-    if exports.su2 {
-        io::write_su2(a.output.join("mesh.su2"), mesh.global(), &groups)?;
-    }
-    let cell_size = (region.area() / report.cells.max(1) as f64).sqrt();
-    if exports.openfoam {
-        let t = a.gis.thickness.unwrap_or(cell_size);
-        io::write_openfoam(a.output.join("openfoam"), mesh.global(), &groups, t)?;
-    }
-    #[cfg(feature = "cgns")]
-    if exports.cgns {
-        unamalla_io::cgns::write_cgns(a.output.join("mesh.cgns"), mesh, &groups)?;
-    }
-    if let (true, Some(p)) = (a.gis.lonlat, &loaded.projection) {
-        let g = mesh.global();
-        let ll = g
-            .nodes()
-            .iter()
-            .map(|&q| p.inverse(q))
-            .collect::<Result<Vec<_>, _>>()?;
-        let back = QuadMesh::new(ll, g.cells().to_vec())?;
-        io::write_msh_quads(a.output.join("mesh-lonlat.msh"), &back, "domain", &groups)?;
-    }
-    write_text(
-        &a.output.join("decomposition.json"),
-        &result.decomposition.to_json(),
-    )?;
-    write_text(
-        &a.output.join("decomposition.svg"),
-        &result.decomposition.to_svg(&result.simplified),
-    )?;
-    write_text(
-        &a.output.join("mesh.svg"),
-        &render::quality_svg(mesh.global(), Some(&result.simplified), 1200.0),
-    )?;
-    write_bytes(
-        &a.output.join("mesh.png"),
-        &render::quality_png(mesh.global(), Some(&result.simplified), 1600)?,
-    )?;
     let json = serde_json::to_string_pretty(&report)?;
-    write_text(&a.output.join("report.json"), &json)?;
-    if !a.gis.no_report {
-        let settings = crate::report::Settings::of_run(&a, &loaded, &groups);
-        let html = crate::report::report_html(&result, &report, &settings);
-        write_text(&a.output.join("report.html"), &html)?;
-    }
-    if a.json {
+    writing(&a.output, || {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let arrays = quad_cell_metrics(mesh.global());
+        let global: Vec<(&str, &[f64])> = arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
+        let block_arrays: Vec<Vec<(&'static str, Vec<f64>)>> =
+            mesh.blocks().iter().map(quad_cell_metrics).collect();
+        let block_refs: Vec<Vec<(&str, &[f64])>> = block_arrays
+            .iter()
+            .map(|b| b.iter().map(|(k, v)| (*k, v.as_slice())).collect())
+            .collect();
+        let block_slices: Vec<&[(&str, &[f64])]> =
+            block_refs.iter().map(|v| v.as_slice()).collect();
+        io::write_block_mesh(dir, mesh, &block_slices, &global)?;
+        let groups = if loaded.names.is_empty() {
+            io::msh::boundary_edge_groups(mesh.global())
+        } else {
+            io::named_edge_groups(mesh.global(), &region, &loaded.names)?
+        };
+        if exports.msh {
+            io::write_msh_blocks(dir.join("mesh.msh"), mesh, "domain", &groups)?;
+        }
+        if exports.su2 {
+            io::write_su2(dir.join("mesh.su2"), mesh.global(), &groups)?;
+        }
+        let cell_size = (region.area() / report.cells.max(1) as f64).sqrt();
+        if exports.openfoam {
+            let t = a.gis.thickness.unwrap_or(cell_size);
+            io::write_openfoam(dir.join("openfoam"), mesh.global(), &groups, t)?;
+        }
+        #[cfg(feature = "cgns")]
+        if exports.cgns {
+            unamalla_io::cgns::write_cgns(dir.join("mesh.cgns"), mesh, &groups)?;
+        }
+        if let (true, Some(p)) = (a.gis.lonlat, &loaded.projection) {
+            let g = mesh.global();
+            let ll = g
+                .nodes()
+                .iter()
+                .map(|&q| p.inverse(q))
+                .collect::<Result<Vec<_>, _>>()?;
+            let back = QuadMesh::new(ll, g.cells().to_vec())?;
+            io::write_msh_quads(dir.join("mesh-lonlat.msh"), &back, "domain", &groups)?;
+        }
+        write_text(
+            &dir.join("decomposition.json"),
+            &result.decomposition.to_json(),
+        )?;
+        write_text(
+            &dir.join("decomposition.svg"),
+            &result.decomposition.to_svg(&result.simplified),
+        )?;
+        write_text(
+            &dir.join("mesh.svg"),
+            &render::quality_svg(mesh.global(), Some(&result.simplified), 1200.0),
+        )?;
+        write_bytes(
+            &dir.join("mesh.png"),
+            &render::quality_png(mesh.global(), Some(&result.simplified), 1600)?,
+        )?;
+        write_text(&dir.join("report.json"), &json)?;
+        if !a.gis.no_report {
+            let settings = crate::report::Settings::of_run(a, loaded, &groups);
+            let html = crate::report::report_html(&result, &report, &settings);
+            write_text(&dir.join("report.html"), &html)?;
+        }
+        Ok(())
+    })?;
+    if a.json && !multi {
         println!("{json}");
     } else if !a.quiet {
         println!(
@@ -294,7 +389,7 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
             a.output.display()
         );
     }
-    Ok(())
+    Ok((serde_json::to_value(&report)?, not_met))
 }
 
 /// Reads a mesh file of any format `unamalla mesh` writes: VTK legacy (`.vtk`), VTK XML
@@ -370,8 +465,23 @@ pub fn eval(path: &Path, name: &str, omega: Option<f64>, k: Option<f64>, raw: bo
 }
 
 /// `unamalla smooth`.
-pub fn smooth(path: &Path, functional: &str, solver: &str, out: &Path, quiet: bool) -> Result<()> {
+pub fn smooth(
+    path: &Path,
+    functional: &str,
+    solver: &str,
+    out: &Path,
+    quiet: bool,
+    allow_non_convex: bool,
+) -> Result<()> {
     let mut mesh = read_quad_mesh(path)?;
+    unamalla_core::preflight::check_size(
+        "the mesh",
+        path.display(),
+        unamalla_core::mesh::HasNodes::num_nodes(&mesh) as f64,
+        "nodes",
+        unamalla_core::preflight::COST_PER_SMOOTH_NODE,
+        reliability::limit()?,
+    )?;
     let mut opts = SmoothOptions {
         functional: functional.parse()?,
         ..SmoothOptions::default()
@@ -381,9 +491,20 @@ pub fn smooth(path: &Path, functional: &str, solver: &str, out: &Path, quiet: bo
     let mut null = NullObserver;
     let observer: &mut dyn Observer = if quiet { &mut null } else { &mut progress };
     let report = optim::smooth(&mut mesh, &opts, observer)?;
+    let v = unamalla_core::verify::verify_quads(
+        &mesh,
+        None,
+        &unamalla_core::verify::VerifyOptions::default(),
+    );
+    let not_met = reliability::guarantee(&v, allow_non_convex, "smooth")?;
     let arrays = quad_cell_metrics(&mesh);
     let data: Vec<(&str, &[f64])> = arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
-    io::write_vtk_quads(out, &mesh, &data)?;
+    writing(out, || {
+        let mut files = OutputFiles::new();
+        let tmp = files.stage(out)?;
+        io::write_vtk_quads(&tmp, &mesh, &data)?;
+        Ok(files.commit()?)
+    })?;
     eprintln!(
         "{}: Alfamin/mean {:.4}, Inocon {} (was {}), F {:.6e}",
         report.status,
@@ -392,19 +513,20 @@ pub fn smooth(path: &Path, functional: &str, solver: &str, out: &Path, quiet: bo
         report.initial_inocon,
         report.f
     );
-    Ok(())
+    reliability::finish(not_met)
 }
 
 /// `unamalla simplify`.
 pub fn simplify(
     path: &Path,
+    part: Option<usize>,
     method: &str,
     epsilon: Option<f64>,
     delta: Option<f64>,
     out: &Path,
     svg: Option<&Path>,
 ) -> Result<()> {
-    let region = read_region(path)?;
+    let region = reliability::read_one_region(path, part)?;
     let opts = SimplifyOptions {
         method: method.parse()?,
         epsilon,
@@ -413,10 +535,14 @@ pub fn simplify(
     };
     let r = contour::simplify_region(&region, &opts)?;
     let overlay = svg.map(|_| contour::overlay_svg(&region, &r.region));
-    io::write_region_geojson(out, &r.region)?;
-    if let (Some(p), Some(text)) = (svg, overlay) {
-        write_text(p, &text)?;
-    }
+    writing(out, || {
+        let mut files = OutputFiles::new();
+        files.write(out, io::region_to_geojson(&r.region).as_bytes())?;
+        if let (Some(p), Some(text)) = (svg, overlay) {
+            files.write(p, text.as_bytes())?;
+        }
+        Ok(files.commit()?)
+    })?;
     eprintln!(
         "{} -> {} vertices, area change {:.4} %, Hausdorff {:.4}",
         r.vertices_before,
@@ -471,9 +597,12 @@ pub struct DecomposeArgs {
     /// the cell size of `--cells`), so the file fits `unamalla mesh --decomposition`.
     #[arg(long)]
     pub no_simplify: bool,
-    /// Cell count the feature removal is sized for, as `unamalla mesh --cells`.
-    #[arg(long, default_value_t = 20_000)]
+    /// Cell count the feature removal is sized for, as `unamalla mesh --cells` (at least 1).
+    #[arg(long, default_value_t = 20_000, allow_negative_numbers = true, value_parser = reliability::positive_count)]
     pub cells: usize,
+    /// For a MultiPolygon: which part (0-based); required when the file has several.
+    #[arg(long)]
+    pub part: Option<usize>,
 }
 
 /// `unamalla decompose`: the automatic decomposition (or a file's, validated) of the region
@@ -482,11 +611,9 @@ pub struct DecomposeArgs {
 /// `no_simplify`. A `from` file that does not fit the simplified region is tried on the region
 /// as read (a file made by hand for the original rings).
 pub fn decompose(a: DecomposeArgs) -> Result<()> {
-    if a.cells == 0 {
-        bail!("--cells must be at least 1");
-    }
-    let raw = read_region(&a.region)?;
+    let raw = reliability::read_one_region(&a.region, a.part)?;
     let region = if a.no_simplify {
+        unamalla_core::preflight::check_unsimplified(&raw)?;
         raw.clone()
     } else {
         Mesher::new()
@@ -510,10 +637,14 @@ pub fn decompose(a: DecomposeArgs) -> Result<()> {
             region,
         ),
     };
-    write_text(&a.output, &d.to_json())?;
-    if let Some(p) = &a.svg {
-        write_text(p, &d.to_svg(&region))?;
-    }
+    writing(&a.output, || {
+        let mut files = OutputFiles::new();
+        files.write(&a.output, d.to_json().as_bytes())?;
+        if let Some(p) = &a.svg {
+            files.write(p, d.to_svg(&region).as_bytes())?;
+        }
+        Ok(files.commit()?)
+    })?;
     let tol = dec::Tolerances::default();
     let admissible = (0..d.blocks.len())
         .filter(|&b| d.block_admissible(b, &tol))

@@ -7,9 +7,8 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use unamalla_core::compat_ilp::{self as ilp, CompatProblem};
-use unamalla_core::io;
 
 /// Arguments of `unamalla counts`.
 #[derive(clap::Args, Debug)]
@@ -43,7 +42,7 @@ pub fn run(a: CountsArgs) -> Result<()> {
     })?;
     let opts = match (a.density, a.cell_size) {
         (_, Some(h)) if !(h.is_finite() && h > 0.0) => {
-            bail!("--cell-size must be a positive number")
+            crate::reliability::usage!("--cell-size must be a positive number")
         }
         (_, Some(h)) => ilp::SolveOptions::cell_size(h),
         (Some(d), _) => ilp::SolveOptions::density(d),
@@ -62,8 +61,11 @@ pub fn run(a: CountsArgs) -> Result<()> {
     }))?;
     match &a.output {
         Some(out) => {
-            io::atomic_write(out, |w| w.write_all(json.as_bytes()))
-                .with_context(|| format!("writing {}", out.display()))?;
+            crate::commands::writing(out, || {
+                let mut files = unamalla_core::output::OutputFiles::new();
+                files.write(out, json.as_bytes())?;
+                Ok(files.commit()?)
+            })?;
             eprintln!(
                 "{} curves, {} blocks, Σm = {} -> {}",
                 problem.curves.len(),

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use unamalla_core::hex::{
     read_face_dir, run_hex, write_outputs, HexAlgorithm, HexCase, HexRunOptions, HexScaling,
     Perturbation,
@@ -27,7 +27,7 @@ pub struct HexArgs {
     /// Perturbation amplitude s (each interior node moves up to s × its shortest edge);
     /// 0 for none. Default: the smallest amplitude giving the thesis's number of non-convex
     /// cells at the start (none for the box and for face directories).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub perturb: Option<f64>,
     /// Instead of an amplitude: perturb until at least this many cells are non-convex.
     #[arg(long, conflicts_with = "perturb")]
@@ -70,6 +70,9 @@ pub struct HexArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// Write the grid even if cells stay non-convex (warning, exit code 3).
+    #[arg(long)]
+    pub allow_non_convex: bool,
 }
 
 fn parse_size3(s: &str) -> Result<(usize, usize, usize), String> {
@@ -93,12 +96,14 @@ pub fn run(a: HexArgs) -> Result<()> {
     let algorithm = match a.algorithm.to_ascii_lowercase().as_str() {
         "a" => HexAlgorithm::A,
         "b" | "ab" => HexAlgorithm::AB,
-        other => bail!("--algorithm must be 'a' or 'b', got '{other}'"),
+        other => crate::reliability::usage!("--algorithm must be 'a' or 'b', got '{other}'"),
     };
     let scaling = match a.scaling.to_ascii_lowercase().as_str() {
         "parametric" => HexScaling::Parametric,
         "index" => HexScaling::Index,
-        other => bail!("--scaling must be 'parametric' or 'index', got '{other}'"),
+        other => {
+            crate::reliability::usage!("--scaling must be 'parametric' or 'index', got '{other}'")
+        }
     };
     let mut coplanarity = match a.b_schedule.to_ascii_lowercase().as_str() {
         "default" => HexRunOptions::default().coplanarity,
@@ -106,7 +111,9 @@ pub fn run(a: HexArgs) -> Result<()> {
             solver: HexRunOptions::default().coplanarity.solver,
             ..CoplanarityOptions::thesis()
         },
-        other => bail!("--b-schedule must be 'default' or 'thesis', got '{other}'"),
+        other => {
+            crate::reliability::usage!("--b-schedule must be 'default' or 'thesis', got '{other}'")
+        }
     };
     let mu0 = a.mu0.unwrap_or(coplanarity.mu0);
     for (name, v, lo) in [
@@ -122,27 +129,37 @@ pub fn run(a: HexArgs) -> Result<()> {
         }
     }
     if a.mu_min >= mu0 {
-        bail!("--mu-min ({}) must be below --mu0 ({mu0})", a.mu_min);
+        crate::reliability::usage!("--mu-min ({}) must be below --mu0 ({mu0})", a.mu_min);
     }
     if a.b_iters == 0 || a.a_iters == 0 {
-        bail!("--a-iters and --b-iters must be at least 1");
+        crate::reliability::usage!("--a-iters and --b-iters must be at least 1");
     }
     if let Some(s) = a.perturb {
         if !(s.is_finite() && s >= 0.0) {
-            bail!("--perturb must be a number ≥ 0, got {s}");
+            crate::reliability::usage!("--perturb must be a number ≥ 0, got {s}");
         }
     }
     let dir = PathBuf::from(&a.case);
     let builtin = a.case.parse::<HexCase>().ok();
     let (name, mut grid, default_perturb) = if builtin.is_none() && dir.is_dir() {
         if a.size.is_some() {
-            bail!("--size applies to built-in cases; a face directory fixes the size");
+            crate::reliability::usage!(
+                "--size applies to built-in cases; a face directory fixes the size"
+            );
         }
         let region = read_face_dir(&dir)?;
         (a.case.clone(), region.tfi()?, Perturbation::None)
     } else {
         let case: HexCase = a.case.parse()?;
         let dims = a.size.unwrap_or_else(|| case.default_size());
+        unamalla_core::preflight::check_size(
+            "--size",
+            format!("{},{},{}", dims.0, dims.1, dims.2),
+            dims.0 as f64 * dims.1 as f64 * dims.2 as f64,
+            "nodes",
+            unamalla_core::preflight::COST_PER_HEX_NODE,
+            crate::reliability::limit()?,
+        )?;
         (
             case.name().to_string(),
             case.initial_grid(dims)?,
@@ -188,8 +205,14 @@ pub fn run(a: HexArgs) -> Result<()> {
     report.case = name;
     report.perturbation = amp;
     report.seed = a.seed;
-    let files = write_outputs(&a.output, &grid, &report)
-        .with_context(|| format!("writing into {}", a.output.display()))?;
+    let v = unamalla_core::verify::verify_hexes(&grid);
+    let not_met = crate::reliability::guarantee(&v, a.allow_non_convex, "hex")?;
+    let out = unamalla_core::output::OutputDir::create(&a.output)?;
+    let files = crate::commands::writing(&a.output, || {
+        let f = write_outputs(out.path(), &grid, &report)?;
+        out.commit()?;
+        Ok(f)
+    })?;
     if a.json {
         println!("{}", report.to_json());
     } else {
@@ -231,11 +254,19 @@ pub fn run(a: HexArgs) -> Result<()> {
     if !a.quiet {
         eprintln!(
             "wrote {}, {}, {}, {}",
-            files.vts.display(),
-            files.vtu.display(),
-            files.report.display(),
-            files.svg.display()
+            a.output
+                .join(files.vts.file_name().unwrap_or_default())
+                .display(),
+            a.output
+                .join(files.vtu.file_name().unwrap_or_default())
+                .display(),
+            a.output
+                .join(files.report.file_name().unwrap_or_default())
+                .display(),
+            a.output
+                .join(files.svg.file_name().unwrap_or_default())
+                .display()
         );
     }
-    Ok(())
+    crate::reliability::finish(not_met)
 }

@@ -20,8 +20,12 @@
 //!   [--solver sor|direct] [--omega w] -o <outdir> [--json]`
 //! * `unamalla refine <mesh> --factor k [--factor-i ki] [--factor-j kj] -o out.vtk`
 //!
-//! Errors are reported as one line on stderr with a non-zero exit code; output files are
-//! written atomically, so a failed run never leaves a partial file.
+//! Errors are reported as one line on stderr with a non-zero exit code (0 ok, 1 input error,
+//! 2 usage error, 3 guarantee not met, 4 other — see [`reliability`]). Every run writes its
+//! whole output set or nothing ([`unamalla_core::output`]): a directory output is staged beside
+//! the target and renamed into place, single files are staged and renamed together, so a
+//! failed run leaves the target as it was. Before success is reported the output is checked
+//! independently ([`unamalla_core::verify`]).
 
 // Issue #14: no `unwrap`/`expect` on paths user input can reach (tests may use them).
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
@@ -35,11 +39,13 @@ mod counts;
 mod hex;
 mod pde;
 mod refine;
+mod reliability;
 mod report;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
-use unamalla_core::io::{self, PartSelector, VtkMesh};
+use reliability::{finite_number, parse_part, positive_count, PartArg};
+use unamalla_core::io::{self, VtkMesh};
 use unamalla_core::mesh::quality::{quad_cell_metrics, QualityReport};
 use unamalla_core::single_block::{tfi_region, Corners};
 
@@ -47,7 +53,10 @@ use unamalla_core::single_block::{tfi_region, Corners};
 #[command(
     name = "unamalla",
     version,
-    about = "Structured and block-structured quad/hex meshes with convex cells"
+    about = "Structured and block-structured quad/hex meshes with convex cells",
+    after_help = "Exit codes: 0 ok, 1 input error, 2 usage error (or a size above the memory limit, \
+                  UNAMALLA_MAX_MEMORY, default 4G), 3 the guarantee (convex cells inside the region) is not met, \
+                  4 other (writing failed, internal error)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -70,7 +79,7 @@ enum Command {
         /// Choose the four corners automatically (the default when --corners is absent).
         #[arg(long)]
         auto_corners: bool,
-        /// For a MultiPolygon: which part (0-based); default the largest.
+        /// For a MultiPolygon: which part (0-based); required when the file has several.
         #[arg(long)]
         part: Option<usize>,
         /// Output VTK legacy file (`.vtk`), with per-cell quality arrays.
@@ -79,6 +88,10 @@ enum Command {
         /// Print the quality report as JSON instead of a table.
         #[arg(long)]
         json: bool,
+        /// Write the grid even if a cell is not convex or lies outside the region (exit code 3
+        /// and a warning).
+        #[arg(long)]
+        allow_non_convex: bool,
     },
     /// The main job: a block-structured, singularity-free, all-convex quad mesh of a region.
     Mesh {
@@ -93,14 +106,14 @@ enum Command {
         /// reclassification is needed, else cuts).
         #[arg(long, default_value = "cuts", value_parser = ["cuts", "submap", "auto"])]
         strategy: String,
-        /// About this many cells (default 20000).
-        #[arg(long, conflicts_with_all = ["density", "cell_size"])]
+        /// About this many cells (default 20000; at least 1).
+        #[arg(long, conflicts_with_all = ["density", "cell_size"], allow_negative_numbers = true, value_parser = positive_count)]
         cells: Option<usize>,
-        /// The thesis's density factor d.
-        #[arg(long, conflicts_with = "cell_size")]
+        /// The thesis's density factor d (at least 1).
+        #[arg(long, conflicts_with = "cell_size", allow_negative_numbers = true, value_parser = positive_count)]
         density: Option<usize>,
         /// Target cell size in region units.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = finite_number)]
         cell_size: Option<f64>,
         /// Boundary density w of (6.9) (1 = plain (6.8)).
         #[arg(long, default_value_t = 1.0)]
@@ -120,7 +133,15 @@ enum Command {
         /// does not depend on the machine.
         #[arg(long)]
         time_limit: Option<f64>,
-        /// Output directory.
+        /// For a MultiPolygon: `all` (the default: every part is meshed, into `part-K/`
+        /// subdirectories with a summary `report.json`) or one part's 0-based index.
+        #[arg(long, value_parser = parse_part)]
+        part: Option<PartArg>,
+        /// Write the mesh even if it fails the independent check (non-convex cells, cells
+        /// outside the region, area or holes off), with a warning and exit code 3.
+        #[arg(long)]
+        allow_non_convex: bool,
+        /// Output directory (replaced as a whole: it must be new, empty or a previous output).
         #[arg(short, long)]
         output: PathBuf,
         /// Print report.json on stdout.
@@ -169,6 +190,9 @@ enum Command {
         /// No progress line.
         #[arg(long)]
         quiet: bool,
+        /// Write the mesh even if cells stay non-convex (warning, exit code 3).
+        #[arg(long)]
+        allow_non_convex: bool,
     },
     /// Simplify a region's contour.
     Simplify {
@@ -189,6 +213,9 @@ enum Command {
         /// Overlay picture (original and simplified rings).
         #[arg(long)]
         svg: Option<PathBuf>,
+        /// For a MultiPolygon: which part (0-based); required when the file has several.
+        #[arg(long)]
+        part: Option<usize>,
     },
     /// Decompose a region into admissible four-sided blocks.
     Decompose(commands::DecomposeArgs),
@@ -256,27 +283,48 @@ fn run(cli: Cli) -> Result<()> {
             part,
             output,
             json,
+            allow_non_convex,
         } => {
-            let sel = part.map_or(PartSelector::Largest, PartSelector::Index);
-            let (reg, removed) = io::read_region_geojson_cleaned(&region, sel)?;
-            if removed > 0 {
-                eprintln!("note: removed {removed} repeated point(s) from the region");
-            }
+            unamalla_core::preflight::check_size(
+                "--size",
+                format!("{m}x{n}"),
+                m as f64 * n as f64,
+                "nodes",
+                unamalla_core::preflight::COST_PER_TFI_NODE,
+                reliability::limit()?,
+            )?;
+            let reg = reliability::read_one_region(&region, part)?;
             let corners = match corners {
                 Some(c) => Corners::Input(c),
                 None => Corners::Auto,
             };
             let grid = tfi_region(&reg, corners, m, n)?;
+            let v = unamalla_core::verify::verify_quads(
+                &grid,
+                Some(&reg),
+                &unamalla_core::verify::VerifyOptions::default(),
+            );
+            let not_met = reliability::guarantee(&v, allow_non_convex, "tfi")?;
             let arrays = quad_cell_metrics(&grid);
             let data: Vec<(&str, &[f64])> =
                 arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
-            io::write_vtk_structured2(&output, &grid, &data)
-                .with_context(|| format!("writing {}", output.display()))?;
+            let write = || -> Result<()> {
+                let mut files = unamalla_core::output::OutputFiles::new();
+                let tmp = files.stage(&output)?;
+                io::write_vtk_structured2(&tmp, &grid, &data)?;
+                files.commit()?;
+                Ok(())
+            };
+            write().context(reliability::WriteFailed(format!(
+                "writing {}",
+                output.display()
+            )))?;
             let report = QualityReport::for_quads(&grid);
             print_report(&report, json);
             if !json {
                 eprintln!("wrote {} ({}x{} nodes)", output.display(), m, n);
             }
+            reliability::finish(not_met)?;
         }
         Command::Mesh {
             region,
@@ -290,6 +338,8 @@ fn run(cli: Cli) -> Result<()> {
             no_simplify,
             feature_factor,
             time_limit,
+            part,
+            allow_non_convex,
             output,
             json,
             quiet,
@@ -306,6 +356,8 @@ fn run(cli: Cli) -> Result<()> {
             no_simplify,
             feature_factor,
             time_limit,
+            part,
+            allow_non_convex,
             output,
             json,
             quiet,
@@ -325,7 +377,15 @@ fn run(cli: Cli) -> Result<()> {
             solver,
             output,
             quiet,
-        } => commands::smooth(&mesh, &functional, &solver, &output, quiet)?,
+            allow_non_convex,
+        } => commands::smooth(
+            &mesh,
+            &functional,
+            &solver,
+            &output,
+            quiet,
+            allow_non_convex,
+        )?,
         Command::Simplify {
             region,
             method,
@@ -333,7 +393,16 @@ fn run(cli: Cli) -> Result<()> {
             delta,
             output,
             svg,
-        } => commands::simplify(&region, &method, epsilon, delta, &output, svg.as_deref())?,
+            part,
+        } => commands::simplify(
+            &region,
+            part,
+            &method,
+            epsilon,
+            delta,
+            &output,
+            svg.as_deref(),
+        )?,
         Command::Decompose(args) => commands::decompose(args)?,
         Command::Counts(args) => counts::run(args)?,
         Command::Bspline(args) => bspline::run(args)?,
@@ -358,9 +427,32 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    // a panic is an internal error: one line, exit 4 (never a backtrace dump for users)
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        eprintln!(
+            "error: internal error (please report): {}{at}",
+            msg.replace('\n', " ")
+        );
+    }));
     let cli = Cli::parse();
-    match run(cli) {
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli)));
+    let result = match outcome {
+        Ok(r) => r,
+        Err(_) => return ExitCode::from(reliability::EXIT_OTHER),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<reliability::WrittenNotMet>() => ExitCode::from(reliability::EXIT_NOT_MET),
         Err(e) => {
             // One line: the context chain joined by ": ", skipping a cause whose text the
             // message already contains (library errors such as `IoError::Geometry` print
@@ -373,8 +465,11 @@ fn main() -> ExitCode {
                     msg.push_str(&c);
                 }
             }
-            eprintln!("error: {}", msg.replace('\n', " "));
-            ExitCode::FAILURE
+            eprintln!(
+                "error: {}",
+                reliability::clean_paths(&msg.replace('\n', " "))
+            );
+            ExitCode::from(reliability::exit_code(&e))
         }
     }
 }

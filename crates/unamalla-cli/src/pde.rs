@@ -129,7 +129,7 @@ fn parse_source(s: &str) -> Result<Source> {
     Ok(match kind.trim() {
         "const" => Source::Constant(v),
         "sin" => Source::Sinusoidal { amplitude: v },
-        k => bail!("--g: unknown kind '{k}' (const, sin)"),
+        k => crate::reliability::usage!("--g: unknown kind '{k}' (const, sin)"),
     })
 }
 
@@ -142,7 +142,7 @@ fn parse_side_value(s: &str) -> Result<SideValue> {
         "const" => SideValue::Constant(v),
         "parabolic" => SideValue::Parabolic { peak: v },
         "sin" => SideValue::Sinusoidal { peak: v },
-        k => bail!("--bc: unknown kind '{k}' (const, parabolic, sin)"),
+        k => crate::reliability::usage!("--bc: unknown kind '{k}' (const, parabolic, sin)"),
     })
 }
 
@@ -169,6 +169,33 @@ pub fn parse_bc(s: &str) -> Result<[SideValue; 4]> {
     Ok(sides)
 }
 
+/// Largest magnitude of a coefficient or data value: the 9-point stencil multiplies them by
+/// each other and by squared mesh spacings, so beyond ~10¹⁵⁰ the products overflow f64 (10³⁰⁸).
+pub const MAX_DATA_MAGNITUDE: f64 = 1e150;
+
+/// Numeric overflow named before solving (instead of "SOR diverged" after it).
+fn check_overflow(a: &PdeArgs) -> Result<()> {
+    for (name, v) in [("--a", a.a), ("--b", a.b), ("--c", a.c), ("--d", a.d)] {
+        if !v.is_finite() || v.abs() > MAX_DATA_MAGNITUDE {
+            crate::reliability::usage!(
+                "{name} {v}: numeric overflow — |value| above {MAX_DATA_MAGNITUDE:e} overflows the stencil products; rescale the equation"
+            );
+        }
+    }
+    for (name, text) in [("--g", &a.g), ("--bc", &a.bc)] {
+        for tok in text.split([',', '=', ':']) {
+            if let Ok(v) = tok.trim().parse::<f64>() {
+                if !v.is_finite() || v.abs() > MAX_DATA_MAGNITUDE {
+                    crate::reliability::usage!(
+                        "{name} {text}: numeric overflow — the value {v:e} is above {MAX_DATA_MAGNITUDE:e} in magnitude and overflows f64 in the stencil; rescale the data"
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// `unamalla pde`.
 pub fn run(a: PdeArgs) -> Result<()> {
     let mesh = read_input_mesh(&a.mesh)?;
@@ -176,11 +203,11 @@ pub fn run(a: PdeArgs) -> Result<()> {
         "sor" => Method::Sor { omega: a.omega },
         "direct" => {
             if a.omega.is_some() {
-                bail!("--omega applies to --solver sor only");
+                crate::reliability::usage!("--omega applies to --solver sor only");
             }
             Method::Direct
         }
-        s => bail!("--solver: unknown solver '{s}' (sor, direct)"),
+        s => crate::reliability::usage!("--solver: unknown solver '{s}' (sor, direct)"),
     };
     let opts = SolveOptions {
         method,
@@ -201,6 +228,7 @@ pub fn run(a: PdeArgs) -> Result<()> {
         Some(m) => m.sides(),
         None => parse_bc(&a.bc)?,
     };
+    check_overflow(&a)?;
     let (sol, nodes): (Solution, Vec<_>) = match &mesh {
         InputMesh::Grid(g) => (
             solve_grid(g, &eq, &sides, &opts)?,
@@ -215,7 +243,7 @@ pub fn run(a: PdeArgs) -> Result<()> {
                             .filter(|t| !t.trim().is_empty())
                             .all(|t| t.split_once('=').is_some_and(|(k, _)| k.trim() == "all"));
                     if !uniform {
-                        bail!("--bc: {} is a general quad mesh without four sides; give `all=const:V`", a.mesh.display());
+                        crate::reliability::usage!("--bc: {} is a general quad mesh without four sides; give `all=const:V`", a.mesh.display());
                     }
                     sides[0].clone()
                 }
@@ -227,40 +255,51 @@ pub fn run(a: PdeArgs) -> Result<()> {
         }
     };
 
-    std::fs::create_dir_all(&a.output)
-        .with_context(|| format!("creating {}", a.output.display()))?;
-    let vtk = a.output.join("solution.vtk");
-    let png = a.output.join("solution.png");
-    let svg = a.output.join("solution.svg");
-    let gm = a.output.join("solution.mesh");
-    let point: Vec<(&str, &[f64])> = vec![("u", sol.u.as_slice())];
-    match &mesh {
-        InputMesh::Grid(g) => {
-            let cells = quad_cell_metrics(g);
-            let cd: Vec<(&str, &[f64])> = cells.iter().map(|(k, v)| (*k, v.as_slice())).collect();
-            io::write_vtk_structured2_with_point_data(&vtk, g, &cd, &point)?;
-            io::write_geomview_mesh(&gm, g, Some(&sol.u))?;
-            io::atomic_write(&png, |w| {
-                let bytes = render::field_png(g, &sol.u, None, 1200)
-                    .map_err(|e| std::io::Error::other(e.to_string()))?;
-                w.write_all(&bytes)
-            })?;
-            let text = render::field_svg(g, &sol.u, None, 900.0)?;
-            io::atomic_write(&svg, |w| w.write_all(text.as_bytes()))?;
-        }
-        InputMesh::Quads(q) => {
-            let cells = quad_cell_metrics(q);
-            let cd: Vec<(&str, &[f64])> = cells.iter().map(|(k, v)| (*k, v.as_slice())).collect();
-            io::write_vtk_quads_with_point_data(&vtk, q, &cd, &point)?;
-            io::atomic_write(&png, |w| {
-                let bytes = render::field_png(q, &sol.u, None, 1200)
-                    .map_err(|e| std::io::Error::other(e.to_string()))?;
-                w.write_all(&bytes)
-            })?;
-            let text = render::field_svg(q, &sol.u, None, 900.0)?;
-            io::atomic_write(&svg, |w| w.write_all(text.as_bytes()))?;
-        }
+    if let Some(k) = sol.u.iter().position(|v| !v.is_finite()) {
+        bail!(
+            "numeric overflow: the solution is not finite at node {k} ({}); the data (--a … --d, --g, --bc) are too large for f64 — rescale the equation",
+            sol.u[k]
+        );
     }
+    let out = unamalla_core::output::OutputDir::create(&a.output)?;
+    let vtk = out.join("solution.vtk");
+    let png = out.join("solution.png");
+    let svg = out.join("solution.svg");
+    let gm = out.join("solution.mesh");
+    crate::commands::writing(&a.output, || {
+        let point: Vec<(&str, &[f64])> = vec![("u", sol.u.as_slice())];
+        match &mesh {
+            InputMesh::Grid(g) => {
+                let cells = quad_cell_metrics(g);
+                let cd: Vec<(&str, &[f64])> =
+                    cells.iter().map(|(k, v)| (*k, v.as_slice())).collect();
+                io::write_vtk_structured2_with_point_data(&vtk, g, &cd, &point)?;
+                io::write_geomview_mesh(&gm, g, Some(&sol.u))?;
+                io::atomic_write(&png, |w| {
+                    let bytes = render::field_png(g, &sol.u, None, 1200)
+                        .map_err(|e| std::io::Error::other(e.to_string()))?;
+                    w.write_all(&bytes)
+                })?;
+                let text = render::field_svg(g, &sol.u, None, 900.0)?;
+                io::atomic_write(&svg, |w| w.write_all(text.as_bytes()))?;
+            }
+            InputMesh::Quads(q) => {
+                let cells = quad_cell_metrics(q);
+                let cd: Vec<(&str, &[f64])> =
+                    cells.iter().map(|(k, v)| (*k, v.as_slice())).collect();
+                io::write_vtk_quads_with_point_data(&vtk, q, &cd, &point)?;
+                io::atomic_write(&png, |w| {
+                    let bytes = render::field_png(q, &sol.u, None, 1200)
+                        .map_err(|e| std::io::Error::other(e.to_string()))?;
+                    w.write_all(&bytes)
+                })?;
+                let text = render::field_svg(q, &sol.u, None, 900.0)?;
+                io::atomic_write(&svg, |w| w.write_all(text.as_bytes()))?;
+            }
+        }
+        out.commit()?;
+        Ok(())
+    })?;
 
     let (umin, umax) = sol
         .u

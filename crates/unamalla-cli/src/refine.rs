@@ -69,6 +69,16 @@ pub fn run(a: RefineArgs) -> Result<()> {
             a.output.display()
         );
     }
+    let fine_nodes =
+        ((grid.m() - 1) as f64 * ki as f64 + 1.0) * ((grid.n() - 1) as f64 * kj as f64 + 1.0);
+    unamalla_core::preflight::check_size(
+        "--factor",
+        format!("{ki}x{kj}"),
+        fine_nodes,
+        "nodes",
+        unamalla_core::preflight::COST_PER_TFI_NODE,
+        crate::reliability::limit()?,
+    )?;
     let fine = grid.refined(ki - 1, kj - 1)?;
     let cells = quad_cell_metrics(&fine);
     let cd: Vec<(&str, &[f64])> = cells.iter().map(|(k, v)| (*k, v.as_slice())).collect();
@@ -77,12 +87,17 @@ pub fn run(a: RefineArgs) -> Result<()> {
         .file_name()
         .and_then(|s| s.to_str())
         .unwrap_or("refined");
-    match ext.as_str() {
-        "vtk" => io::write_vtk_structured2(&a.output, &fine, &cd)?,
-        "vts" => io::write_vts2(&a.output, &fine, &cd)?,
-        "xy" => io::write_xy(&a.output, &fine, name)?,
-        _ => io::write_red(&a.output, &fine, name)?,
-    }
+    crate::commands::writing(&a.output, || {
+        let mut files = unamalla_core::output::OutputFiles::new();
+        let tmp = files.stage(&a.output)?;
+        match ext.as_str() {
+            "vtk" => io::write_vtk_structured2(&tmp, &fine, &cd)?,
+            "vts" => io::write_vts2(&tmp, &fine, &cd)?,
+            "xy" => io::write_xy(&tmp, &fine, name)?,
+            _ => io::write_red(&tmp, &fine, name)?,
+        }
+        Ok(files.commit()?)
+    })?;
     println!(
         "{} × {} → {} × {} nodes ({} cells, {} non-convex)",
         grid.m(),

@@ -233,10 +233,8 @@ impl OutputDir {
                 Err(e) => {
                     // another run's set took the place: it is whole, try again; any other
                     // error: put the old set back
-                    if moved_aside {
-                        if fs::rename(&old, &self.target).is_err() {
-                            let _ = fs::remove_dir_all(&old);
-                        }
+                    if moved_aside && fs::rename(&old, &self.target).is_err() {
+                        let _ = fs::remove_dir_all(&old);
                     }
                     if !self.target.exists() {
                         return Err(io_err(&self.target, "moving the new output into place")(e));

@@ -107,11 +107,13 @@ pub enum Strategy {
 /// (or a smaller factor) to keep them.
 pub const DEFAULT_FEATURE_FACTOR: f64 = 5.0;
 
-/// Largest accepted relative area change of the mesh against the **input** region (10 %),
+/// Largest accepted relative area change of the mesh against the **input** region (20 %),
 /// checked when no hole was dropped on purpose: the default simplification keeps the change
-/// below 2 % on the bundled regions (docs/results.md); a mesh with far fewer cells than the
-/// region's features (`--cells 1`: 32 % on Texas) or a lost part is above.
-pub const INPUT_AREA_TOLERANCE: f64 = 0.10;
+/// below 2 % on the bundled regions (docs/results.md), and the feature removal may drop a
+/// notch that cannot be meshed at the cell size (the bad-input catalogue's near-touching notch:
+/// 11 %); a mesh with far fewer cells than the region's features (`--cells 1` on Texas: 32 %)
+/// or a lost MultiPolygon part is above.
+pub const INPUT_AREA_TOLERANCE: f64 = 0.20;
 
 /// Angle tolerance (degrees) of the [`Strategy::Auto`] rule.
 pub const AUTO_ANGLE_TOLERANCE_DEG: f64 = 10.0;

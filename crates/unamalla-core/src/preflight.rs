@@ -152,7 +152,7 @@ pub fn parse_bytes(s: &str) -> Option<u64> {
         _ => (t, 1),
     };
     let v: f64 = num.trim().parse().ok()?;
-    (v.is_finite() && v > 0.0 && v * (mult as f64) < 1.8e19).then(|| (v * mult as f64) as u64)
+    (v.is_finite() && v > 0.0 && v * (mult as f64) < 1.8e19).then_some((v * mult as f64) as u64)
 }
 
 /// The memory limit: [`MEMORY_LIMIT_ENV`] if set, else [`DEFAULT_MEMORY_LIMIT`].
@@ -245,7 +245,7 @@ pub fn ring_gaps(region: &Region) -> Option<(usize, usize, f64)> {
 /// closer than [`MIN_GAP_FRACTION`] × `h`; other errors pass unchanged. Guarantee and
 /// preflight errors are never replaced.
 pub fn explain_failure(e: CoreError, region: &Region, h: f64) -> CoreError {
-    if matches!(e, CoreError::Guarantee(_) | CoreError::Preflight(_)) || !(h > 0.0) {
+    if matches!(e, CoreError::Guarantee(_) | CoreError::Preflight(_)) || h.is_nan() || h <= 0.0 {
         return e;
     }
     match ring_gaps(region) {

@@ -219,7 +219,8 @@ pub fn verify_quads<M: HasQuadCells>(
         if m.is_nan() || m < v.min_corner {
             v.min_corner = m;
         }
-        if !(m > 0.0) {
+        // NaN counts as not convex
+        if m.is_nan() || m <= 0.0 {
             v.non_convex_cells += 1;
             if v.non_convex_examples.len() < LISTED_CELLS {
                 v.non_convex_examples.push(c);
@@ -308,7 +309,8 @@ pub fn verify_hexes<M: HasHexCells>(mesh: &M) -> Verification {
         if m.is_nan() || m < v.min_corner {
             v.min_corner = m;
         }
-        if !(m > 0.0) {
+        // NaN counts as not convex
+        if m.is_nan() || m <= 0.0 {
             v.non_convex_cells += 1;
             if v.non_convex_examples.len() < LISTED_CELLS {
                 v.non_convex_examples.push(c);
