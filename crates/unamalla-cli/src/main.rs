@@ -34,6 +34,7 @@ mod commands;
 mod counts;
 mod hex;
 mod pde;
+mod progress;
 mod refine;
 mod report;
 
