@@ -33,7 +33,7 @@ fn puget() -> &'static Path {
         bin()
             .arg("mesh")
             .arg(repo().join("fixtures/patches/puget-sound-patches.geojson"))
-            .args(["--cells", "6000", "--quiet", "--export", &exports, "-o"])
+            .args(["--cells", "6500", "--quiet", "--export", &exports, "-o"])
             .arg(&out)
             .run_ok();
         out
