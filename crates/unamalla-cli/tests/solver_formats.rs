@@ -408,3 +408,37 @@ fn report_html_is_self_contained_and_renders_in_chromium() {
     );
     std::fs::remove_dir_all(profile).ok();
 }
+
+#[test]
+fn binary_mesh_vtu_is_read_by_meshio_and_vtk() {
+    let out = puget();
+    let vtu = out.join("mesh.vtu");
+    let text = std::fs::read_to_string(&vtu).unwrap();
+    assert!(
+        text.contains("format=\"binary\""),
+        "a mesh above the threshold is binary"
+    );
+    let cells = report(out)["cells"].as_u64().unwrap();
+    let script = format!(
+        "import meshio, vtk\nm = meshio.read({p:?})\nr = vtk.vtkXMLUnstructuredGridReader()\nr.SetFileName({p:?})\nr.Update()\nprint(len(m.cells_dict['quad']), r.GetOutput().GetNumberOfCells())",
+        p = vtu.display().to_string()
+    );
+    let Ok(o) = Command::new("python3").args(["-c", &script]).output() else {
+        println!("skipped: python3 not found");
+        return;
+    };
+    if !o.status.success() {
+        println!(
+            "skipped: meshio or vtk not installed ({})",
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+        );
+        return;
+    }
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).trim(),
+        format!("{cells} {cells}")
+    );
+}
