@@ -287,15 +287,17 @@ fn mesh_part(
         )?;
         mesher = mesher.decomposition(d);
     }
-    if !a.quiet {
-        mesher = mesher.on_progress(|_, msg| eprintln!("· {msg}"));
+    let progress = (!a.quiet).then(crate::progress::Progress::for_stderr);
+    if let Some(p) = &progress {
+        let p = p.clone();
+        mesher = mesher.on_progress(move |stage, msg| p.stage(stage, msg));
     }
-    let mut progress = ProgressObserver::new(Duration::from_millis(200));
-    let mut null = NullObserver;
-    let observer: &mut dyn Observer = if a.quiet { &mut null } else { &mut progress };
-    let result = mesher.mesh_observed(&region, observer);
-    if !a.quiet {
-        progress.finish();
+    let result = match &progress {
+        Some(p) => mesher.mesh_observed(&region, &mut p.observer()),
+        None => mesher.mesh_observed(&region, &mut NullObserver),
+    };
+    if let Some(p) = &progress {
+        p.finish();
     }
     let result = result.with_context(|| format!("{name}: nothing written"))?;
     let mut report = result.report.clone();

@@ -38,6 +38,7 @@ mod commands;
 mod counts;
 mod hex;
 mod pde;
+mod progress;
 mod refine;
 mod reliability;
 mod report;

@@ -146,11 +146,11 @@ fn mesh_svg(result: &MeshResult, mu: &[f64]) -> String {
     let pt = |p: DVec2| format!("{:.6},{:.6}", p.x, -p.y);
     // one path per band keeps the page small
     let mut bands: [String; 3] = Default::default();
-    for c in 0..g.num_quads() {
+    for (c, &m) in mu.iter().enumerate().take(g.num_quads()) {
         let q = g.quad(c);
-        let b = if mu[c] >= 0.8 {
+        let b = if m >= 0.8 {
             0
-        } else if mu[c] >= 0.4 {
+        } else if m >= 0.4 {
             1
         } else {
             2
@@ -375,7 +375,7 @@ th{{background:#f3f3f3}}td.l,th.l{{text-align:left}}.legend span{{display:inline
             esc(&format!("{st:?}").to_lowercase())
         );
     }
-    let _ = write!(h, "</table><script>{SCRIPT}</script></body></html>\n");
+    let _ = writeln!(h, "</table><script>{SCRIPT}</script></body></html>");
     h
 }
 

@@ -4,7 +4,10 @@
 //! [`write_cgns`] writes, through the CGNS mid-level library (CGNS SIDS, "Standard Interface
 //! Data Structures", AIAA R-101A; mid-level library manual `cg_*` calls):
 //!
-//! * one `CGNSBase_t` `Base`, cell dimension 2, physical dimension 2;
+//! * one `CGNSBase_t` `Base`, cell dimension 2, physical dimension 2, `DataClass`
+//!   `NormalizedByUnknownDimensional` (lengths are in the region's units, km for projected
+//!   GIS input, which SIDS `DimensionalUnits` cannot name) and `DimensionalExponents` of a
+//!   length on each coordinate;
 //! * **one `Zone_t` per block** (`block-<b>`, `Structured`, size `[m, n, m−1, n−1]`) with
 //!   `GridCoordinates/CoordinateX, CoordinateY` (i fastest, as the block's node order);
 //! * **`GridConnectivity1to1_t` across every cut**: each maximal run of a block side shared
@@ -50,6 +53,7 @@ const BC_GENERAL: c_int = 8;
 const BC_INFLOW: c_int = 9;
 const BC_OUTFLOW: c_int = 13;
 const BC_WALL: c_int = 20;
+const NORMALIZED_BY_UNKNOWN_DIMENSIONAL: c_int = 4;
 
 #[link(name = "cgns")]
 extern "C" {
@@ -104,6 +108,8 @@ extern "C" {
     fn cg_family_write(fn_: c_int, b: c_int, name: *const c_char, f: *mut c_int) -> c_int;
     fn cg_goto(fn_: c_int, b: c_int, ...) -> c_int;
     fn cg_famname_write(name: *const c_char) -> c_int;
+    fn cg_dataclass_write(dataclass: c_int) -> c_int;
+    fn cg_exponents_write(ty: c_int, exponents: *const std::ffi::c_void) -> c_int;
     fn cg_get_error() -> *const c_char;
 }
 
@@ -349,6 +355,14 @@ pub fn write_cgns(
             if cg_base_write(file.0, bname.as_ptr(), 2, 2, &mut base) != 0 {
                 return Err(fail("base"));
             }
+            // lengths are in the region's units (km for projected GIS input), which SIDS's
+            // DimensionalUnits cannot express: declare them normalized by an unknown unit
+            let end = cstr("end")?;
+            if cg_goto(file.0, base, end.as_ptr()) != 0
+                || cg_dataclass_write(NORMALIZED_BY_UNKNOWN_DIMENSIONAL) != 0
+            {
+                return Err(fail("data class"));
+            }
             for g in groups {
                 let mut fam = 0;
                 let n = cstr(&g.name)?;
@@ -389,6 +403,29 @@ pub fn write_cgns(
                     ) != 0
                     {
                         return Err(fail("coordinates"));
+                    }
+                    // a length: exponents (mass, length, time, temperature, angle) = (0,1,0,0,0)
+                    let (zt, gc, da, end) = (
+                        cstr("Zone_t")?,
+                        cstr("GridCoordinates_t")?,
+                        cstr("DataArray_t")?,
+                        cstr("end")?,
+                    );
+                    let exps: [f64; 5] = [0.0, 1.0, 0.0, 0.0, 0.0];
+                    if cg_goto(
+                        file.0,
+                        base,
+                        zt.as_ptr(),
+                        z,
+                        gc.as_ptr(),
+                        ONE,
+                        da.as_ptr(),
+                        c,
+                        end.as_ptr(),
+                    ) != 0
+                        || cg_exponents_write(REAL_DOUBLE, exps.as_ptr().cast()) != 0
+                    {
+                        return Err(fail("exponents"));
                     }
                 }
                 zones.push(z);

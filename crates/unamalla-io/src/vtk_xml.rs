@@ -1,5 +1,5 @@
 //! VTK XML files: `.vts` (structured grid), `.vtu` (unstructured grid), `.vtm` (multiblock
-//! index), ASCII data arrays.
+//! index); ASCII data arrays, binary (base64) ones above [`BINARY_THRESHOLD_POINTS`] points.
 //!
 //! # Writing
 //!
@@ -14,6 +14,8 @@
 //! * [`write_block_mesh`]: a whole [`BlockMesh2`] in one call — `block-K.vts` per block,
 //!   `blocks.vtm` indexing them and `mesh.vtu` for the global conformal mesh.
 //!
+//! Meshes with more than [`BINARY_THRESHOLD_POINTS`] points get binary data arrays.
+//!
 //! Every file is written atomically ([`crate::atomic_write`]); cell arrays are validated first
 //! exactly like the legacy writers do (one finite value per cell, printable ASCII names without
 //! whitespace, no duplicates). Numbers use the shortest round-trip representation, so a
@@ -24,8 +26,10 @@
 //! [`read_vtk_xml`] / [`parse_vtk_xml`] read `.vts` and `.vtu` files in ASCII format (the subset
 //! the writers produce, and what VTK/ParaView/meshio write with `format="ascii"`) into the same
 //! [`VtkFile`] the legacy reader returns (its `title` is empty). One `<Piece>` whose extent is
-//! the whole extent; unstructured grids of all quads or all hexahedra. `binary`/`appended` data
-//! arrays are reported as [`IoError::Unsupported`]. [`read_vtm`] lists the data sets of a
+//! the whole extent; unstructured grids of all quads or all hexahedra. Binary data arrays
+//! (`format="binary"`: base64, uncompressed, `UInt64` or `UInt32` header — what the writers
+//! produce above the threshold and VTK/meshio write with `binary`) are read too; `appended`
+//! and compressed arrays are reported as [`IoError::Unsupported`]. [`read_vtm`] lists the data sets of a
 //! `.vtm`, resolved against its directory. Errors carry 1-based line numbers.
 
 use std::io::{self, Write};
@@ -54,8 +58,58 @@ fn head(w: &mut dyn Write, kind: &str) -> io::Result<()> {
     )
 }
 
-fn points_array(w: &mut dyn Write, pts: impl Iterator<Item = DVec3>) -> io::Result<()> {
+/// Meshes with more points than this are written with binary data arrays
+/// (`format="binary"`: base64 of a `UInt64` byte count, then base64 of the little-endian
+/// values, encoded separately as VTK and meshio do), smaller ones in ASCII. Both read back bit
+/// for bit (sizes measured in `docs/solvers-and-gis.md`).
+pub const BINARY_THRESHOLD_POINTS: usize = 10_000;
+
+/// Base64 text of a binary data array: the 8-byte little-endian byte count, then the bytes,
+/// each encoded separately.
+fn binary_text(bytes: &[u8]) -> String {
+    use base64::Engine as _;
+    let e = &base64::engine::general_purpose::STANDARD;
+    let mut s = e.encode((bytes.len() as u64).to_le_bytes());
+    s.push_str(&e.encode(bytes));
+    s
+}
+
+fn f64_bytes(v: impl Iterator<Item = f64>) -> Vec<u8> {
+    v.flat_map(f64::to_le_bytes).collect()
+}
+
+fn binary_array(
+    w: &mut dyn Write,
+    ty: &str,
+    name: &str,
+    comps: usize,
+    bytes: &[u8],
+) -> io::Result<()> {
+    let nc = if comps > 1 {
+        format!(" NumberOfComponents=\"{comps}\"")
+    } else {
+        String::new()
+    };
+    writeln!(
+        w,
+        "        <DataArray type=\"{ty}\" Name=\"{}\"{nc} format=\"binary\">",
+        xml::escape(name)
+    )?;
+    writeln!(w, "          {}", binary_text(bytes))?;
+    writeln!(w, "        </DataArray>")
+}
+
+fn points_array(
+    w: &mut dyn Write,
+    pts: impl Iterator<Item = DVec3>,
+    binary: bool,
+) -> io::Result<()> {
     writeln!(w, "      <Points>")?;
+    if binary {
+        let bytes = f64_bytes(pts.flat_map(|p| [p.x, p.y, p.z]));
+        binary_array(w, "Float64", "Points", 3, &bytes)?;
+        return writeln!(w, "      </Points>");
+    }
     writeln!(
         w,
         "        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">"
@@ -84,14 +138,18 @@ fn data_array(w: &mut dyn Write, ty: &str, name: &str, values: &[String]) -> io:
     writeln!(w, "        </DataArray>")
 }
 
-fn cell_data_section(w: &mut dyn Write, cell_data: &CellData<'_>) -> io::Result<()> {
+fn cell_data_section(w: &mut dyn Write, cell_data: &CellData<'_>, binary: bool) -> io::Result<()> {
     if cell_data.is_empty() {
         return Ok(());
     }
     writeln!(w, "      <CellData>")?;
     for &(name, values) in cell_data {
-        let v: Vec<String> = values.iter().map(|x| format!("{x:?}")).collect();
-        data_array(w, "Float64", name, &v)?;
+        if binary {
+            binary_array(w, "Float64", name, 1, &f64_bytes(values.iter().copied()))?;
+        } else {
+            let v: Vec<String> = values.iter().map(|x| format!("{x:?}")).collect();
+            data_array(w, "Float64", name, &v)?;
+        }
     }
     writeln!(w, "      </CellData>")
 }
@@ -132,14 +190,15 @@ pub fn write_vts3(
 fn write_vts_body(
     w: &mut dyn Write,
     ext: &str,
-    pts: impl Iterator<Item = DVec3>,
+    pts: impl ExactSizeIterator<Item = DVec3>,
     cell_data: &CellData<'_>,
 ) -> io::Result<()> {
+    let binary = pts.len() > BINARY_THRESHOLD_POINTS;
     head(w, "StructuredGrid")?;
     writeln!(w, "  <StructuredGrid WholeExtent=\"{ext}\">")?;
     writeln!(w, "    <Piece Extent=\"{ext}\">")?;
-    cell_data_section(w, cell_data)?;
-    points_array(w, pts)?;
+    cell_data_section(w, cell_data, binary)?;
+    points_array(w, pts, binary)?;
     writeln!(w, "    </Piece>")?;
     writeln!(w, "  </StructuredGrid>")?;
     writeln!(w, "</VTKFile>")
@@ -209,22 +268,36 @@ fn write_vtu_body(
         w,
         "    <Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nc}\">"
     )?;
-    cell_data_section(w, cell_data)?;
-    points_array(w, pts)?;
+    let binary = np > BINARY_THRESHOLD_POINTS;
+    cell_data_section(w, cell_data, binary)?;
+    points_array(w, pts, binary)?;
     writeln!(w, "      <Cells>")?;
-    writeln!(
-        w,
-        "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
-    )?;
-    for c in 0..nc {
-        let ids: Vec<String> = cell(c).iter().map(|v| v.to_string()).collect();
-        writeln!(w, "          {}", ids.join(" "))?;
+    if binary {
+        let conn: Vec<u8> = (0..nc)
+            .flat_map(cell)
+            .flat_map(|v| (v as i64).to_le_bytes())
+            .collect();
+        binary_array(w, "Int64", "connectivity", 1, &conn)?;
+        let offsets: Vec<u8> = (1..=nc)
+            .flat_map(|c| ((c * nv) as i64).to_le_bytes())
+            .collect();
+        binary_array(w, "Int64", "offsets", 1, &offsets)?;
+        binary_array(w, "UInt8", "types", 1, &vec![ty; nc])?;
+    } else {
+        writeln!(
+            w,
+            "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+        )?;
+        for c in 0..nc {
+            let ids: Vec<String> = cell(c).iter().map(|v| v.to_string()).collect();
+            writeln!(w, "          {}", ids.join(" "))?;
+        }
+        writeln!(w, "        </DataArray>")?;
+        let offsets: Vec<String> = (1..=nc).map(|c| (c * nv).to_string()).collect();
+        data_array(w, "Int64", "offsets", &offsets)?;
+        let types: Vec<String> = (0..nc).map(|_| ty.to_string()).collect();
+        data_array(w, "UInt8", "types", &types)?;
     }
-    writeln!(w, "        </DataArray>")?;
-    let offsets: Vec<String> = (1..=nc).map(|c| (c * nv).to_string()).collect();
-    data_array(w, "Int64", "offsets", &offsets)?;
-    let types: Vec<String> = (0..nc).map(|_| ty.to_string()).collect();
-    data_array(w, "UInt8", "types", &types)?;
     writeln!(w, "      </Cells>")?;
     writeln!(w, "    </Piece>")?;
     writeln!(w, "  </UnstructuredGrid>")?;
@@ -369,7 +442,7 @@ pub fn read_vtm(path: impl AsRef<Path>) -> Result<Vec<VtmEntry>, IoError> {
     Ok(out)
 }
 
-/// Reads a `.vts` or `.vtu` file (ASCII data arrays) — see the [module docs](self).
+/// Reads a `.vts` or `.vtu` file (ASCII or binary data arrays) — see the [module docs](self).
 pub fn read_vtk_xml(path: impl AsRef<Path>) -> Result<VtkFile, IoError> {
     let path = path.as_ref();
     let text = read_text(path)?;
@@ -481,8 +554,27 @@ fn parse_extent(e: &Element, name: &str, path: &Path) -> Result<[i64; 6], IoErro
 
 /// The numbers of an ASCII `<DataArray>`, exactly `count` of them.
 fn array_values(e: &Element, count: usize, path: &Path) -> Result<Vec<f64>, IoError> {
-    check_ascii(e, path)?;
     let name = e.attr("Name").unwrap_or("(unnamed)");
+    if is_binary(e, path)? {
+        let v = binary_values(e, path)?;
+        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+            return Err(IoError::Malformed {
+                path: path.to_path_buf(),
+                line: e.text_line,
+                message: format!("DataArray {name}: value {k} is not finite"),
+            });
+        }
+        if v.len() != count {
+            return Err(IoError::CountMismatch {
+                path: path.to_path_buf(),
+                line: e.line,
+                what: format!("DataArray {name} values"),
+                expected: count,
+                found: v.len(),
+            });
+        }
+        return Ok(v);
+    }
     let mut lx = Lexer::starting_at(&e.text, path, e.text_line);
     let mut v = Vec::with_capacity(count.min(MAX_PREALLOC));
     while let Some((t, line)) = lx.next() {
@@ -526,10 +618,24 @@ fn lx_rest_count(lx: &mut Lexer<'_>) -> usize {
 
 /// Integer `<DataArray>` (connectivity, offsets, types).
 fn array_ints(e: &Element, count: Option<usize>, path: &Path) -> Result<Vec<usize>, IoError> {
-    check_ascii(e, path)?;
     let name = e.attr("Name").unwrap_or("(unnamed)");
-    let mut lx = Lexer::starting_at(&e.text, path, e.text_line);
     let mut v = Vec::with_capacity(count.unwrap_or(0).min(MAX_PREALLOC));
+    let binary = is_binary(e, path)?;
+    if binary {
+        for (k, x) in binary_values(e, path)?.into_iter().enumerate() {
+            if !(x >= 0.0 && x.fract() == 0.0 && x < 9.0e15) {
+                return Err(IoError::Malformed {
+                    path: path.to_path_buf(),
+                    line: e.text_line,
+                    message: format!(
+                        "DataArray {name}: value {k} ({x}) is not a non-negative integer"
+                    ),
+                });
+            }
+            v.push(x as usize);
+        }
+    }
+    let mut lx = Lexer::starting_at(if binary { "" } else { &e.text }, path, e.text_line);
     while let Some((t, line)) = lx.next() {
         let x = t.parse::<usize>().map_err(|_| IoError::Malformed {
             path: path.to_path_buf(),
@@ -552,15 +658,83 @@ fn array_ints(e: &Element, count: Option<usize>, path: &Path) -> Result<Vec<usiz
     Ok(v)
 }
 
-fn check_ascii(e: &Element, path: &Path) -> Result<(), IoError> {
+/// Whether a `<DataArray>` is binary (`format="binary"`, uncompressed); other formats than
+/// `ascii` and `binary`, and compressed data, are unsupported.
+fn is_binary(e: &Element, path: &Path) -> Result<bool, IoError> {
     match e.attr("format") {
-        None | Some("ascii") => Ok(()),
+        None | Some("ascii") => Ok(false),
+        Some("binary") => Ok(true),
         Some(f) => Err(IoError::Unsupported {
             path: path.to_path_buf(),
             line: e.line,
-            what: format!("DataArray format {f:?} (only ascii is read)"),
+            what: format!("DataArray format {f:?} (ascii and binary are read)"),
         }),
     }
+}
+
+/// The values of a binary `<DataArray>` as `f64`: its base64 text decoded (a `UInt64` or
+/// `UInt32` byte count encoded separately, then the data), the data read per its `type`.
+fn binary_values(e: &Element, path: &Path) -> Result<Vec<f64>, IoError> {
+    use base64::Engine as _;
+    let eng = &base64::engine::general_purpose::STANDARD;
+    let name = e.attr("Name").unwrap_or("(unnamed)");
+    let bad = |m: String| IoError::Malformed {
+        path: path.to_path_buf(),
+        line: e.text_line,
+        message: format!("DataArray {name}: {m}"),
+    };
+    let text: String = e.text.split_whitespace().collect();
+    // header: 8 bytes (12 base64 characters) or 4 bytes (8 characters), whichever states the
+    // length of the rest
+    let mut data = None;
+    for (chars, size) in [(12usize, 8usize), (8, 4)] {
+        if text.len() < chars {
+            continue;
+        }
+        let (Ok(h), Ok(d)) = (eng.decode(&text[..chars]), eng.decode(&text[chars..])) else {
+            continue;
+        };
+        if h.len() != size {
+            continue;
+        }
+        let mut b = [0u8; 8];
+        b[..size].copy_from_slice(&h);
+        if u64::from_le_bytes(b) == d.len() as u64 {
+            data = Some(d);
+            break;
+        }
+    }
+    let d =
+        data.ok_or_else(|| bad("binary data is not base64 of a byte count and the data".into()))?;
+    let ty = e.attr("type").unwrap_or("");
+    let width = match ty {
+        "Float64" | "Int64" | "UInt64" => 8,
+        "Float32" | "Int32" | "UInt32" => 4,
+        "Int16" | "UInt16" => 2,
+        "Int8" | "UInt8" => 1,
+        other => return Err(bad(format!("unsupported binary type {other:?}"))),
+    };
+    if d.len() % width != 0 {
+        return Err(bad(format!(
+            "{} bytes is not a whole number of {ty}",
+            d.len()
+        )));
+    }
+    Ok(d.chunks_exact(width)
+        .map(|c| {
+            let mut b = [0u8; 8];
+            b[..width].copy_from_slice(c);
+            match ty {
+                "Float64" => f64::from_le_bytes(b),
+                "Float32" => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                "Int64" => i64::from_le_bytes(b) as f64,
+                "Int32" => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                "Int16" => i16::from_le_bytes([b[0], b[1]]) as f64,
+                "Int8" => b[0] as i8 as f64,
+                _ => u64::from_le_bytes(b) as f64,
+            }
+        })
+        .collect())
 }
 
 fn components(e: &Element, path: &Path) -> Result<usize, IoError> {
@@ -799,4 +973,76 @@ fn read_unstructured(root: &Element, path: &Path) -> Result<VtkFile, IoError> {
         cell_data,
         point_data,
     })
+}
+
+#[cfg(test)]
+mod binary_tests {
+    use super::*;
+
+    #[test]
+    fn a_large_grid_is_written_binary_and_reads_back_bit_for_bit() {
+        // 120 × 100 nodes = 12 000 > threshold; irrational coordinates test every bit
+        let g = StructuredGrid2::from_fn(120, 100, |i, j| {
+            DVec2::new(
+                (i as f64).sqrt() + 0.1 * j as f64,
+                (j as f64) / 3.0 + 1e-7 * i as f64,
+            )
+        })
+        .unwrap();
+        let dir = std::env::temp_dir().join(format!("unamalla-vtkbin-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let cells: Vec<f64> = (0..g.num_cells()).map(|c| (c as f64).ln_1p()).collect();
+        let data: &[(&str, &[f64])] = &[("q", &cells)];
+        write_vts2(dir.join("g.vts"), &g, data).unwrap();
+        let q = QuadMesh::from_grid(&g);
+        write_vtu_quads(dir.join("g.vtu"), &q, data).unwrap();
+        let vts = std::fs::read_to_string(dir.join("g.vts")).unwrap();
+        assert!(vts.contains("format=\"binary\"") && !vts.contains("format=\"ascii\""));
+        let back = read_vtk_xml(dir.join("g.vts")).unwrap();
+        assert_eq!(back.mesh, VtkMesh::Structured2(g.clone()));
+        assert_eq!(back.cell_array("q"), Some(&cells[..]));
+        let back = read_vtk_xml(dir.join("g.vtu")).unwrap();
+        assert_eq!(back.mesh, VtkMesh::Quads(q));
+        // binary is smaller than ASCII of the same data: 8 bytes per value × 4/3 base64 vs
+        // up to 20 decimal characters
+        let small = StructuredGrid2::from_fn(120, 83, |i, j| g.node(i, j)).unwrap();
+        assert!(small.num_nodes() <= BINARY_THRESHOLD_POINTS);
+        let scells: Vec<f64> = (0..small.num_cells()).map(|c| (c as f64).ln_1p()).collect();
+        write_vts2(dir.join("s.vts"), &small, &[("q", &scells)]).unwrap();
+        let ascii_per_node =
+            std::fs::metadata(dir.join("s.vts")).unwrap().len() as f64 / small.num_nodes() as f64;
+        let bin_per_node = vts.len() as f64 / g.num_nodes() as f64;
+        assert!(
+            bin_per_node < 0.75 * ascii_per_node,
+            "{bin_per_node} vs {ascii_per_node}"
+        );
+        std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn a_uint32_header_is_read_and_a_wrong_count_is_an_error() {
+        use base64::Engine as _;
+        let e = &base64::engine::general_purpose::STANDARD;
+        let pts: Vec<u8> = [
+            0.0f64, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0,
+        ]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+        let enc =
+            |b: &[u8], header: u32| format!("{}{}", e.encode(header.to_le_bytes()), e.encode(b));
+        let doc = |header: u32| {
+            format!(
+                r#"<?xml version="1.0"?><VTKFile type="StructuredGrid" version="1.0" byte_order="LittleEndian">
+<StructuredGrid WholeExtent="0 1 0 1 0 0"><Piece Extent="0 1 0 1 0 0"><Points>
+<DataArray type="Float64" NumberOfComponents="3" format="binary">{}</DataArray>
+</Points></Piece></StructuredGrid></VTKFile>"#,
+                enc(&pts, header)
+            )
+        };
+        let f = parse_vtk_xml(&doc(96)).unwrap();
+        assert_eq!(f.mesh.num_nodes(), 4);
+        let err = parse_vtk_xml(&doc(95)).unwrap_err().to_string();
+        assert!(err.contains("not base64 of a byte count"), "{err}");
+    }
 }

@@ -244,10 +244,18 @@ fn reader_errors_are_typed_with_line_numbers() {
     // Non-planar quads.
     let e = parse_vtk_xml(&HAND_VTU.replacen("2 1 0\n", "2 1 7\n", 1)).unwrap_err();
     assert!(matches!(e, IoError::NotPlanar { node: 5, .. }), "{e}");
-    // Binary arrays are unsupported, not misread.
+    // ASCII numbers declared binary are an error, not misread; appended arrays are unsupported.
     let e = parse_vtk_xml(&HAND_VTU.replacen(
         "Name=\"offsets\" format=\"ascii\"",
         "Name=\"offsets\" format=\"binary\"",
+        1,
+    ))
+    .unwrap_err();
+    assert!(matches!(e, IoError::Malformed { .. }), "{e}");
+    assert!(e.to_string().contains("not base64"), "{e}");
+    let e = parse_vtk_xml(&HAND_VTU.replacen(
+        "Name=\"offsets\" format=\"ascii\"",
+        "Name=\"offsets\" format=\"appended\"",
         1,
     ))
     .unwrap_err();
