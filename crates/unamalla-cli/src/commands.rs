@@ -10,7 +10,7 @@ use unamalla_core::contour::{self, HoleFilter, SimplifyOptions};
 use unamalla_core::decompose::{self as dec, Decomposition};
 use unamalla_core::io::{self, PartSelector, VtkMesh};
 use unamalla_core::mesh::quality::quad_cell_metrics;
-use unamalla_core::mesh::{QuadMesh, Region};
+use unamalla_core::mesh::{HasNodes, QuadMesh, Region};
 use unamalla_core::optim::{self, NullObserver, Observer, ProgressObserver, SmoothOptions};
 use unamalla_core::pipeline::{Mesher, Strategy};
 use unamalla_core::render;
@@ -21,6 +21,87 @@ fn read_region(path: &Path) -> Result<Region> {
         eprintln!("note: removed {removed} repeated point(s) from the region");
     }
     Ok(r)
+}
+
+/// Input and export options of `unamalla mesh` (issue #26): region formats, feature
+/// selection, coordinate system, solver formats and the HTML report.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SolverGisArgs {
+    /// Coordinate system of the region: auto (GeoJSON in the lon/lat range without declared
+    /// units, or a shapefile with a geographic .prj, is WGS84 lon/lat), lonlat, planar, or a
+    /// proj string ("+proj=utm +zone=33 +datum=WGS84 +units=m"). Geographic input is meshed in
+    /// a local transverse Mercator projection, lengths in km.
+    #[arg(long, default_value = "auto")]
+    pub crs: String,
+    /// Select a feature by attribute, KEY=VALUE (GeoJSON properties, shapefile .dbf fields).
+    #[arg(long)]
+    pub feature: Option<String>,
+    /// Solver formats to write besides the VTK files, comma-separated: msh, su2, openfoam, cgns
+    /// (cgns needs a build with `--features cgns`), or none.
+    #[arg(long, default_value = "msh,su2,openfoam")]
+    pub export: String,
+    /// Thickness of the one-cell OpenFOAM extrusion (default: the mean cell size).
+    #[arg(long)]
+    pub thickness: Option<f64>,
+    /// With projected input: also write mesh-lonlat.msh with the nodes back-projected to
+    /// longitude/latitude.
+    #[arg(long)]
+    pub lonlat: bool,
+    /// Do not write report.html.
+    #[arg(long)]
+    pub no_report: bool,
+}
+
+/// The solver formats `--export` names.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Exports {
+    msh: bool,
+    su2: bool,
+    openfoam: bool,
+    cgns: bool,
+}
+
+fn parse_exports(s: &str) -> Result<Exports> {
+    let mut e = Exports::default();
+    for t in s.split(',').map(str::trim).filter(|t| !t.is_empty()) {
+        match t {
+            "msh" => e.msh = true,
+            "su2" => e.su2 = true,
+            "openfoam" | "foam" => e.openfoam = true,
+            "cgns" if cfg!(feature = "cgns") => e.cgns = true,
+            "cgns" => bail!(
+                "--export cgns needs a build with the CGNS library: cargo build --features cgns"
+            ),
+            "none" => {}
+            other => bail!("--export: unknown format {other:?} (msh, su2, openfoam, cgns, none)"),
+        }
+    }
+    Ok(e)
+}
+
+/// Reads a region of any supported format (see [`io::input`]), printing the notes (unless
+/// `quiet`) and any warning.
+fn load_region(path: &Path, gis: &SolverGisArgs, quiet: bool) -> Result<io::LoadedRegion> {
+    let opts = io::LoadOptions {
+        feature: gis.feature.clone(),
+        crs: gis.crs.parse()?,
+    };
+    let l = io::load_region(path, &opts)?;
+    if !quiet {
+        for n in &l.notes {
+            eprintln!("note: {n}");
+        }
+        if l.removed_points > 0 {
+            eprintln!(
+                "note: removed {} repeated point(s) from the region",
+                l.removed_points
+            );
+        }
+    }
+    if let Some(w) = &l.warning {
+        eprintln!("warning: {w}");
+    }
+    Ok(l)
 }
 
 fn write_text(path: &Path, text: &str) -> Result<()> {
@@ -49,11 +130,22 @@ pub struct MeshArgs {
     pub output: PathBuf,
     pub json: bool,
     pub quiet: bool,
+    pub gis: SolverGisArgs,
 }
 
 /// `unamalla mesh`.
 pub fn mesh(a: MeshArgs) -> Result<()> {
-    let region = read_region(&a.region)?;
+    let exports = parse_exports(&a.gis.export)?;
+    if let Some(t) = a.gis.thickness {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--thickness must be a positive number");
+        }
+    }
+    let loaded = load_region(&a.region, &a.gis, a.quiet)?;
+    if a.gis.lonlat && loaded.projection.is_none() {
+        bail!("--lonlat needs geographic input (or --crs lonlat / a proj string)");
+    }
+    let region = loaded.region.clone();
     let mut mesher = Mesher::new();
     mesher = match (a.cells, a.density, a.cell_size) {
         (_, _, Some(h)) if !(h.is_finite() && h > 0.0) => {
@@ -111,7 +203,7 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
         progress.finish();
     }
     let result = result?;
-    let mut report = result.report;
+    let mut report = result.report.clone();
     report.region = a
         .region
         .file_stem()
@@ -132,8 +224,36 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
         .collect();
     let block_slices: Vec<&[(&str, &[f64])]> = block_refs.iter().map(|v| v.as_slice()).collect();
     io::write_block_mesh(&a.output, mesh, &block_slices, &global)?;
-    let groups = io::msh::boundary_edge_groups(mesh.global());
-    io::write_msh_quads(a.output.join("mesh.msh"), mesh.global(), "domain", &groups)?;
+    let groups = if loaded.names.is_empty() {
+        io::msh::boundary_edge_groups(mesh.global())
+    } else {
+        io::named_edge_groups(mesh.global(), &region, &loaded.names)?
+    };
+    if exports.msh {
+        io::write_msh_blocks(a.output.join("mesh.msh"), mesh, "domain", &groups)?;
+    }
+    if exports.su2 {
+        io::write_su2(a.output.join("mesh.su2"), mesh.global(), &groups)?;
+    }
+    let cell_size = (region.area() / report.cells.max(1) as f64).sqrt();
+    if exports.openfoam {
+        let t = a.gis.thickness.unwrap_or(cell_size);
+        io::write_openfoam(a.output.join("openfoam"), mesh.global(), &groups, t)?;
+    }
+    #[cfg(feature = "cgns")]
+    if exports.cgns {
+        unamalla_io::cgns::write_cgns(a.output.join("mesh.cgns"), mesh, &groups)?;
+    }
+    if let (true, Some(p)) = (a.gis.lonlat, &loaded.projection) {
+        let g = mesh.global();
+        let ll = g
+            .nodes()
+            .iter()
+            .map(|&q| p.inverse(q))
+            .collect::<Result<Vec<_>, _>>()?;
+        let back = QuadMesh::new(ll, g.cells().to_vec())?;
+        io::write_msh_quads(a.output.join("mesh-lonlat.msh"), &back, "domain", &groups)?;
+    }
     write_text(
         &a.output.join("decomposition.json"),
         &result.decomposition.to_json(),
@@ -152,6 +272,11 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     )?;
     let json = serde_json::to_string_pretty(&report)?;
     write_text(&a.output.join("report.json"), &json)?;
+    if !a.gis.no_report {
+        let settings = crate::report::Settings::of_run(&a, &loaded, &groups);
+        let html = crate::report::report_html(&result, &report, &settings);
+        write_text(&a.output.join("report.html"), &html)?;
+    }
     if a.json {
         println!("{json}");
     } else if !a.quiet {
@@ -170,6 +295,52 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Reads a mesh file of any format `unamalla mesh` writes: VTK legacy (`.vtk`), VTK XML
+/// (`.vtu`, `.vts`; `.vtm`: the blocks it lists merged into one quad mesh) or Gmsh (`.msh`).
+pub fn read_any_mesh(path: &Path) -> Result<io::VtkFile> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    Ok(match ext.as_str() {
+        "vtu" | "vts" => io::read_vtk_xml(path)?,
+        "vtm" => {
+            let dir = path.parent().unwrap_or(Path::new("."));
+            let mut nodes = Vec::new();
+            let mut cells = Vec::new();
+            for e in io::read_vtm(path)? {
+                let f = io::read_vtk_xml(dir.join(&e.file))?;
+                let q = match f.mesh {
+                    VtkMesh::Structured2(g) => QuadMesh::from_grid(&g),
+                    VtkMesh::Quads(q) => q,
+                    _ => bail!("{}: block {} is not a quad mesh", path.display(), e.name),
+                };
+                let off = nodes.len();
+                nodes.extend_from_slice(q.nodes());
+                cells.extend(q.cells().iter().map(|c| c.map(|v| v + off)));
+            }
+            bare_file(VtkMesh::Quads(QuadMesh::new(nodes, cells)?))
+        }
+        "msh" => {
+            let f = io::read_msh(path)?;
+            bare_file(match f.mesh {
+                io::MshMesh::Quads(q) => VtkMesh::Quads(q),
+                io::MshMesh::Hexes(h) => VtkMesh::Hexes(h),
+            })
+        }
+        _ => io::read_vtk(path)?,
+    })
+}
+
+fn bare_file(mesh: VtkMesh) -> io::VtkFile {
+    io::VtkFile {
+        title: String::new(),
+        mesh,
+        cell_data: Vec::new(),
+        point_data: Vec::new(),
+    }
 }
 
 fn read_quad_mesh(path: &Path) -> Result<QuadMesh> {

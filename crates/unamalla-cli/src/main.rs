@@ -35,6 +35,7 @@ mod counts;
 mod hex;
 mod pde;
 mod refine;
+mod report;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
@@ -81,7 +82,7 @@ enum Command {
     },
     /// The main job: a block-structured, singularity-free, all-convex quad mesh of a region.
     Mesh {
-        /// Region file (GeoJSON).
+        /// Region file: GeoJSON, Shapefile (.shp), UNAMALLA .con or plain text rings.
         region: PathBuf,
         /// Use this decomposition file (made for the simplified region, or for the raw region
         /// together with --no-simplify) instead of the automatic one.
@@ -128,6 +129,8 @@ enum Command {
         /// No progress output.
         #[arg(long)]
         quiet: bool,
+        #[command(flatten)]
+        gis: commands::SolverGisArgs,
     },
     /// Value and gradient norm of a functional on a mesh (VTK legacy file).
     Eval {
@@ -202,7 +205,8 @@ enum Command {
     Pde(pde::PdeArgs),
     /// Uniform refinement of a convex structured grid: every cell into k × k (seed 001 RF11).
     Refine(refine::RefineArgs),
-    /// Quality report of a mesh file (VTK legacy: structured grid or quad/hex unstructured grid).
+    /// Quality report of a mesh file: VTK legacy (.vtk), VTK XML (.vtu, .vts, .vtm: every block)
+    /// or Gmsh (.msh).
     Quality {
         /// Mesh file.
         mesh: PathBuf,
@@ -289,6 +293,7 @@ fn run(cli: Cli) -> Result<()> {
             output,
             json,
             quiet,
+            gis,
         } => commands::mesh(commands::MeshArgs {
             region,
             decomposition,
@@ -304,6 +309,7 @@ fn run(cli: Cli) -> Result<()> {
             output,
             json,
             quiet,
+            gis,
         })?,
         Command::Eval {
             mesh,
@@ -335,7 +341,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Pde(args) => pde::run(args)?,
         Command::Refine(args) => refine::run(args)?,
         Command::Quality { mesh, json } => {
-            let file = io::read_vtk(&mesh)?;
+            let file = commands::read_any_mesh(&mesh)?;
             let report = match &file.mesh {
                 VtkMesh::Structured2(g) => QualityReport::for_quads(g),
                 VtkMesh::Quads(q) => QualityReport::for_quads(q),

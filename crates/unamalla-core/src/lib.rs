@@ -36,11 +36,14 @@ pub mod bspline_maps;
 pub mod corners;
 pub mod flat_corners;
 pub mod hex;
+pub mod output;
 pub mod pde;
 pub mod pipeline;
+pub mod preflight;
 pub mod render;
 pub mod single_block;
 pub mod untangle;
+pub mod verify;
 
 pub use unamalla_bspline as bspline;
 pub use unamalla_compat_ilp as compat_ilp;
@@ -92,4 +95,11 @@ pub enum CoreError {
     /// Submapping (seed 002) failed.
     #[error(transparent)]
     Submap(#[from] unamalla_decompose::submap::SubmapError),
+    /// The finished mesh failed the independent check ([`verify`]).
+    #[error(transparent)]
+    Guarantee(#[from] verify::GuaranteeNotMet),
+    /// A size is beyond the memory limit, or a region is beyond what a stage can handle
+    /// ([`preflight`]).
+    #[error(transparent)]
+    Preflight(#[from] preflight::PreflightError),
 }

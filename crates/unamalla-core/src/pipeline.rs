@@ -108,6 +108,12 @@ pub enum Strategy {
 /// (or a smaller factor) to keep them.
 pub const DEFAULT_FEATURE_FACTOR: f64 = 5.0;
 
+/// Largest accepted relative area change of the mesh against the **input** region (10 %),
+/// checked when no hole was dropped on purpose: the default simplification keeps the change
+/// below 2 % on the bundled regions (docs/results.md); a mesh with far fewer cells than the
+/// region's features (`--cells 1`: 32 % on Texas) or a lost part is above.
+pub const INPUT_AREA_TOLERANCE: f64 = 0.10;
+
 /// Angle tolerance (degrees) of the [`Strategy::Auto`] rule.
 pub const AUTO_ANGLE_TOLERANCE_DEG: f64 = 10.0;
 
@@ -155,6 +161,7 @@ pub struct Mesher {
     flat_corner_deficit: f64,
     progress: Option<ProgressFn>,
     strategy: Strategy,
+    allow_non_convex: bool,
 }
 
 impl Default for Mesher {
@@ -224,6 +231,8 @@ pub struct MeshReport {
     pub stage_seconds: Vec<(Stage, f64)>,
     /// The full quality report of the final mesh.
     pub quality: QualityReport,
+    /// The independent check of the final mesh ([`crate::verify`]).
+    pub verification: crate::verify::Verification,
 }
 
 impl Mesher {
@@ -242,6 +251,7 @@ impl Mesher {
             flat_corner_deficit: crate::flat_corners::DEFAULT_MIN_DEFICIT_DEG,
             progress: None,
             strategy: Strategy::Cuts,
+            allow_non_convex: false,
         }
     }
     /// The decomposition strategy (default [`Strategy::Cuts`]).
@@ -319,6 +329,13 @@ impl Mesher {
         self.time_limit = seconds;
         self
     }
+    /// Return a mesh that fails the independent check ([`crate::verify`]) as `Ok`, with the
+    /// failures in [`MeshReport::verification`], instead of [`CoreError::Guarantee`]
+    /// (default `false`; the CLI's `--allow-non-convex`).
+    pub fn allow_non_convex(mut self, allow: bool) -> Self {
+        self.allow_non_convex = allow;
+        self
+    }
     /// A progress callback called at the start of every stage.
     pub fn on_progress(mut self, f: impl FnMut(Stage, &str) + 'static) -> Self {
         self.progress = Some(Box::new(f));
@@ -386,7 +403,65 @@ impl Mesher {
     }
 
     /// Runs the pipeline; `observer` sees every smoothing iteration.
+    ///
+    /// Before the work: the size against the memory limit and the vertex count of an
+    /// unsimplified region ([`crate::preflight`]). A stage failure caused by a too-narrow gap
+    /// between rings is reported as such ([`crate::preflight::explain_failure`]). After the
+    /// work, the mesh is checked independently ([`crate::verify::verify_quads`]: convex cells,
+    /// centroids inside the meshed region, its area and hole count; the area against the input
+    /// region within [`INPUT_AREA_TOLERANCE`] unless holes were dropped on purpose); a failure is
+    /// [`CoreError::Guarantee`] unless [`Mesher::allow_non_convex`] was set.
     pub fn mesh_observed(
+        self,
+        region: &Region,
+        observer: &mut dyn Observer,
+    ) -> Result<MeshResult, CoreError> {
+        use crate::preflight;
+        let h = self.submap_size(region);
+        let limit = preflight::memory_limit()?;
+        let (option, value) = match self.size {
+            MeshSize::Cells(0) => {
+                return Err(CoreError::Unsupported(
+                    "--cells 0: a mesh needs at least 1 cell".into(),
+                ))
+            }
+            MeshSize::Cells(n) => ("--cells", n.to_string()),
+            MeshSize::CellSize(h) => ("--cell-size", h.to_string()),
+            MeshSize::Density(d) => ("--density", d.to_string()),
+        };
+        preflight::check_size(
+            option,
+            &value,
+            region.area() / (h * h),
+            "cells",
+            preflight::COST_PER_MESH_CELL,
+            limit,
+        )?;
+        if self.simplify.is_none() && self.decomposition.is_none() {
+            preflight::check_unsimplified(region)?;
+        }
+        let allow = self.allow_non_convex;
+        let mut result = self
+            .mesh_unverified(region, observer)
+            .map_err(|e| preflight::explain_failure(e, region, h))?;
+        let mut v = crate::verify::verify_quads(
+            result.mesh.global(),
+            Some(&result.simplified),
+            &crate::verify::VerifyOptions::default(),
+        );
+        if result.report.holes_dropped.is_empty() {
+            v.input_area_defect = Some(result.report.area_change_percent / 100.0);
+            v.input_area_tolerance = Some(INPUT_AREA_TOLERANCE);
+        }
+        result.report.verification = v.clone();
+        if !allow {
+            v.into_result()?;
+        }
+        Ok(result)
+    }
+
+    /// The pipeline without the checks of [`Mesher::mesh_observed`].
+    fn mesh_unverified(
         mut self,
         region: &Region,
         observer: &mut dyn Observer,
@@ -588,6 +663,7 @@ impl Mesher {
             seconds: t0.elapsed().as_secs_f64(),
             stage_seconds,
             quality,
+            verification: Default::default(),
         };
         Ok(MeshResult {
             simplified,

@@ -297,6 +297,28 @@ pub enum IoError {
         source: GeometryError,
     },
 
+    /// A boundary patch name or stretch is unusable (see [`crate::patches`]).
+    #[error("boundary patch {name:?}: {reason}")]
+    InvalidPatch {
+        /// The patch name.
+        name: String,
+        /// Why it was rejected.
+        reason: String,
+    },
+
+    /// A `--feature KEY=VALUE` selector matched no polygon (or is malformed).
+    #[error("--feature {selector:?}: {reason}")]
+    FeatureNotFound {
+        /// The selector as given.
+        selector: String,
+        /// Why nothing was selected.
+        reason: String,
+    },
+
+    /// A coordinate reference system could not be set up or applied (see [`crate::geo`]).
+    #[error("coordinate system: {0}")]
+    Crs(String),
+
     /// A named group of boundary elements given to a writer is unusable (bad name, node id out
     /// of range, duplicate name, …).
     #[error("{}: group {name:?}: {reason}", .path.display())]

@@ -478,3 +478,269 @@ mod write_tests {
         assert_eq!(back, r);
     }
 }
+
+/// What a GeoJSON document says about its region besides the rings: boundary names
+/// ([`crate::patches`] convention) and declared units or CRS ([`crate::geo`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RegionAnnotations {
+    /// Patch names of the rings and named stretches.
+    pub names: crate::patches::BoundaryNames,
+    /// `properties.units` of the region's feature, if any (e.g. `"km"`: planar).
+    pub units: Option<String>,
+    /// The pre-RFC 7946 top-level `crs` member's name, if any.
+    pub crs: Option<String>,
+}
+
+impl RegionAnnotations {
+    /// Whether the document declares planar coordinates: `units` given, or a `crs` that is not
+    /// CRS84 / EPSG:4326.
+    pub fn declares_planar(&self) -> bool {
+        self.units.is_some()
+            || self.crs.as_deref().is_some_and(|c| {
+                let c = c.to_ascii_uppercase();
+                !(c.contains("CRS84") || c.ends_with("4326"))
+            })
+    }
+}
+
+/// Reads a region and its annotations ([`RegionAnnotations`]) from a GeoJSON file; repeated
+/// consecutive points are removed as in [`read_region_geojson_cleaned`] (their count is
+/// returned).
+pub fn read_annotated_region_geojson(
+    path: impl AsRef<Path>,
+    part: PartSelector,
+) -> Result<(Region, usize, RegionAnnotations), IoError> {
+    let path = path.as_ref();
+    let text = read_text(path)?;
+    annotated_at(&text, path, part)
+}
+
+/// Like [`read_annotated_region_geojson`], for GeoJSON text held in memory.
+pub fn parse_annotated_region_geojson(
+    text: &str,
+    part: PartSelector,
+) -> Result<(Region, usize, RegionAnnotations), IoError> {
+    annotated_at(text, Path::new(STRING_SOURCE), part)
+}
+
+fn annotated_at(
+    text: &str,
+    path: &Path,
+    part: PartSelector,
+) -> Result<(Region, usize, RegionAnnotations), IoError> {
+    let parts = parse_parts_at(text, path)?;
+    let rings = select_part(parts, part, path)?;
+    // the text parsed as JSON above, so this cannot fail; map the error anyway
+    let value: Value = serde_json::from_str(text).map_err(|e| IoError::Json {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: strip_position(&e.to_string()),
+    })?;
+    let ann = annotations_of(&value, &rings.json_path, path)?;
+    let (region, removed) = to_region(rings, path, true)?;
+    Ok((region, removed, ann))
+}
+
+/// The annotations of the polygon at `part_path` of a parsed document.
+pub(crate) fn annotations_of(
+    value: &Value,
+    part_path: &str,
+    path: &Path,
+) -> Result<RegionAnnotations, IoError> {
+    let bad = |jp: String, problem: String| IoError::MissingMember {
+        path: path.to_path_buf(),
+        json_path: jp,
+        problem,
+    };
+    // the feature holding the selected polygon
+    let (feature, fjp) = match part_path
+        .strip_prefix("$.features[")
+        .and_then(|r| r.split(']').next())
+        .and_then(|k| k.parse::<usize>().ok())
+    {
+        Some(k) => (value["features"].get(k), format!("$.features[{k}]")),
+        None if value["type"] == "Feature" => (Some(value), "$".to_string()),
+        None => (None, String::new()),
+    };
+    let props = feature
+        .and_then(|f| f.get("properties"))
+        .filter(|p| p.is_object());
+    let string_at = |key: &str| -> Result<Option<String>, IoError> {
+        match props.and_then(|p| p.get(key)) {
+            None | Some(Value::Null) => Ok(None),
+            Some(Value::String(s)) => Ok(Some(s.clone())),
+            Some(v) => Err(bad(
+                format!("{fjp}.properties.{key}"),
+                format!("must be a string, found {}", kind_of(v)),
+            )),
+        }
+    };
+    let mut names = crate::patches::BoundaryNames {
+        outer: string_at("patch")?,
+        ..Default::default()
+    };
+    let units = string_at("units")?;
+    let holes_jp = format!("{fjp}.properties.hole_patch");
+    match props.and_then(|p| p.get("hole_patch")) {
+        None | Some(Value::Null) => {}
+        Some(Value::String(s)) => {
+            let nholes = hole_count(value, part_path);
+            names.holes = vec![Some(s.clone()); nholes];
+        }
+        Some(Value::Array(a)) => {
+            for (k, v) in a.iter().enumerate() {
+                names.holes.push(match v {
+                    Value::Null => None,
+                    Value::String(s) => Some(s.clone()),
+                    v => {
+                        return Err(bad(
+                            format!("{holes_jp}[{k}]"),
+                            format!("must be a string or null, found {}", kind_of(v)),
+                        ))
+                    }
+                });
+            }
+        }
+        Some(v) => {
+            return Err(bad(
+                holes_jp,
+                format!("must be a string or an array, found {}", kind_of(v)),
+            ))
+        }
+    }
+    if let Some(feats) = value.get("features").and_then(Value::as_array) {
+        for (k, f) in feats.iter().enumerate() {
+            let jp = format!("$.features[{k}]");
+            let Some(name) = f.get("properties").and_then(|p| p.get("patch")) else {
+                continue;
+            };
+            let g = &f["geometry"];
+            let lines: Vec<&Value> = match g["type"].as_str() {
+                Some("LineString") => vec![&g["coordinates"]],
+                Some("MultiLineString") => g["coordinates"]
+                    .as_array()
+                    .map(|a| a.iter().collect())
+                    .unwrap_or_default(),
+                _ => continue,
+            };
+            let name = name.as_str().ok_or_else(|| {
+                bad(
+                    format!("{jp}.properties.patch"),
+                    format!("must be a string, found {}", kind_of(name)),
+                )
+            })?;
+            for (l, line) in lines.into_iter().enumerate() {
+                let ljp = format!("{jp}.geometry.coordinates");
+                let pts = line
+                    .as_array()
+                    .ok_or_else(|| bad(ljp.clone(), "a line string must be an array".into()))?
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| {
+                        match (
+                            p.get(0).and_then(Value::as_f64),
+                            p.get(1).and_then(Value::as_f64),
+                        ) {
+                            (Some(x), Some(y)) => Ok(DVec2::new(x, y)),
+                            _ => Err(IoError::BadCoordinate {
+                                path: path.to_path_buf(),
+                                json_path: format!("{ljp}[{l}][{i}]"),
+                                problem: "a position must be an array of at least 2 numbers".into(),
+                            }),
+                        }
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                names.stretches.push(crate::patches::Stretch {
+                    name: name.to_string(),
+                    points: pts,
+                });
+            }
+        }
+    }
+    let crs = value
+        .get("crs")
+        .and_then(|c| c.get("properties"))
+        .and_then(|p| p.get("name"))
+        .and_then(Value::as_str)
+        .map(str::to_string);
+    Ok(RegionAnnotations { names, units, crs })
+}
+
+/// The number of holes of the polygon at `part_path` (its ring count − 1).
+fn hole_count(value: &Value, part_path: &str) -> usize {
+    let mut v = value;
+    // walk "$.a[1].b.c[2]" segments
+    for seg in part_path
+        .trim_start_matches('$')
+        .split('.')
+        .filter(|s| !s.is_empty())
+    {
+        let mut it = seg.split('[');
+        if let Some(key) = it.next() {
+            v = &v[key];
+        }
+        for idx in it {
+            if let Ok(k) = idx.trim_end_matches(']').parse::<usize>() {
+                v = &v[k];
+            }
+        }
+    }
+    v.as_array().map_or(0, |a| a.len().saturating_sub(1))
+}
+
+#[cfg(test)]
+mod annotation_tests {
+    use super::*;
+
+    const BOX_WITH_SEA: &str = r#"{"type":"FeatureCollection","features":[
+      {"type":"Feature","properties":{"patch":"coast","hole_patch":["island"]},
+       "geometry":{"type":"Polygon","coordinates":[
+         [[0,0],[4,0],[4,3],[0,3],[0,0]],
+         [[1,1],[1,2],[2,2],[2,1],[1,1]]]}},
+      {"type":"Feature","properties":{"patch":"open-sea"},
+       "geometry":{"type":"LineString","coordinates":[[4,0],[4,3],[0,3]]}},
+      {"type":"Feature","properties":{"name":"not a patch"},
+       "geometry":{"type":"LineString","coordinates":[[0,0],[1,0]]}}]}"#;
+
+    #[test]
+    fn ring_names_and_stretches_are_read() {
+        let (r, removed, a) =
+            parse_annotated_region_geojson(BOX_WITH_SEA, PartSelector::Largest).unwrap();
+        assert_eq!(removed, 0);
+        assert_eq!(r.holes().len(), 1);
+        assert_eq!(a.names.outer.as_deref(), Some("coast"));
+        assert_eq!(a.names.holes, vec![Some("island".to_string())]);
+        assert_eq!(a.names.stretches.len(), 1);
+        assert_eq!(a.names.stretches[0].name, "open-sea");
+        assert_eq!(a.names.stretches[0].points.len(), 3);
+        assert!(!a.declares_planar());
+        crate::patches::validate_names(&r, &a.names).unwrap();
+    }
+
+    #[test]
+    fn one_hole_name_for_all_holes_and_declared_units() {
+        let text = r#"{"type":"Feature","properties":{"hole_patch":"wall","units":"km"},
+          "geometry":{"type":"Polygon","coordinates":[
+            [[0,0],[9,0],[9,9],[0,9],[0,0]],
+            [[1,1],[1,2],[2,2],[1,1]],
+            [[5,5],[5,6],[6,6],[5,5]]]}}"#;
+        let (_, _, a) = parse_annotated_region_geojson(text, PartSelector::Largest).unwrap();
+        assert_eq!(a.names.holes, vec![Some("wall".to_string()); 2]);
+        assert_eq!(a.units.as_deref(), Some("km"));
+        assert!(a.declares_planar());
+    }
+
+    #[test]
+    fn a_bad_patch_member_names_its_json_path() {
+        let text = r#"{"type":"Feature","properties":{"patch":3},
+          "geometry":{"type":"Polygon","coordinates":[[[0,0],[1,0],[1,1],[0,0]]]}}"#;
+        let e = parse_annotated_region_geojson(text, PartSelector::Largest)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("$.properties.patch") && e.contains("a number"),
+            "{e}"
+        );
+    }
+}

@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | GeoJSON (RFC 7946) `Polygon` / `MultiPolygon` / `Feature` / `FeatureCollection` | regions | – | [`geojson`] |
 //! | ESRI Shapefile, polygon shapes (5, 15, 25) | regions | regions (`.shp` + `.shx`) | [`shp`] |
+//! | dBASE `.dbf` attribute tables (the shapefile's `--feature` selector) | records | – | [`dbf`] |
 //! | UNAMALLA contour `.con` (`ibflag` 0/1/13/24, side counts) | contours, regions | contours | [`legacy`] |
 //! | plain text rings (`x y` per line, blank line between rings) | regions | regions | [`rings`] |
 //! | Gmsh MSH 4.1 ASCII: quads (3) / hexahedra (5), `$Entities`, `$PhysicalNames`, named boundary groups | yes | yes | [`msh`] |
@@ -17,6 +18,9 @@
 //! | Plot3D multi-block grids, 2D and 3D, ASCII and Fortran-unformatted binary | yes | yes | [`plot3d`] |
 //! | UNAMALLA XY and RED meshes | yes | yes | [`legacy`] |
 //! | Geomview `MESH` surface | yes | yes | [`legacy`] |
+//! | SU2 native `.su2` (quads, markers = boundary patches) | – | yes | [`solver`] |
+//! | OpenFOAM `constant/polyMesh` (extruded one cell, `frontAndBack` empty, named patches) | – | yes | [`solver`] |
+//! | CGNS structured multi-zone (zone per block, 1-to-1 connectivity, BCs by patch; feature `cgns`) | – | yes | `cgns` |
 //! | OFF / Wavefront OBJ (quad meshes; hex meshes as boundary surfaces) | polygon surfaces | yes | [`surface`] |
 //!
 //! Every mesh writer takes per-cell arrays where the format has them (VTK legacy and XML: e.g.
@@ -28,6 +32,10 @@
 //! (`check_msh_gmsh.py`, PyPI `gmsh`), meshio (`check_vtk_meshio.py`, `.vtk` and `.vtu`) and
 //! VTK's XML readers (`check_vtk_xml_vtk.py`, PyPI `vtk`, `.vts`/`.vtu`/`.vtm`; meshio has no
 //! `.vts` reader).
+//!
+//! Boundary-condition names ([`patches`]) come from GeoJSON properties or the library API and
+//! are carried to every mesh output; longitude/latitude input is projected to a local
+//! transverse Mercator in km ([`geo`]).
 //!
 //! ## Conventions
 //!
@@ -88,13 +96,20 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod atomic;
+#[cfg(feature = "cgns")]
+pub mod cgns;
+pub mod dbf;
 pub mod error;
+pub mod geo;
 pub mod geojson;
+pub mod input;
 pub mod legacy;
 pub mod msh;
+pub mod patches;
 pub mod plot3d;
 pub mod rings;
 pub mod shp;
+pub mod solver;
 pub mod surface;
 pub mod vtk;
 pub mod vtk_xml;
@@ -104,20 +119,25 @@ mod xml;
 
 pub use atomic::atomic_write;
 pub use error::IoError;
+pub use geo::{looks_geographic, CrsChoice, LocalProjection};
 pub use geojson::{
-    parse_polygon_parts, parse_region_geojson, parse_region_geojson_cleaned, parse_region_rings,
+    parse_annotated_region_geojson, parse_polygon_parts, parse_region_geojson,
+    parse_region_geojson_cleaned, parse_region_rings, read_annotated_region_geojson,
     read_region_geojson, read_region_geojson_cleaned, read_region_rings, region_to_geojson,
-    write_region_geojson, PartSelector, PolygonRings,
+    write_region_geojson, PartSelector, PolygonRings, RegionAnnotations,
 };
+pub use input::{load_region, LoadOptions, LoadedRegion};
 pub use legacy::{
     parse_con, parse_geomview_mesh, parse_red, parse_xy, read_con, read_geomview_mesh, read_red,
     read_region_con, read_xy, write_con, write_geomview_mesh, write_red, write_xy, Contour,
     GeomviewMesh, Ibflag, LegacyMesh,
 };
 pub use msh::{
-    boundary_edge_groups, boundary_loops, hex_boundary_faces, parse_msh, read_msh, write_msh_hexes,
-    write_msh_quads, BoundaryLoop, EdgeGroup, FaceGroup, MshFile, MshMesh,
+    boundary_edge_groups, boundary_loops, hex_boundary_faces, parse_msh, read_msh,
+    write_msh_blocks, write_msh_hexes, write_msh_quads, BoundaryLoop, EdgeGroup, FaceGroup,
+    MshFile, MshMesh,
 };
+pub use patches::{named_edge_groups, BoundaryNames, Stretch};
 pub use plot3d::{
     parse_plot3d_ascii, parse_plot3d_binary, read_plot3d, write_plot3d2, write_plot3d3,
     Plot3dBlocks, Plot3dDim, Plot3dFormat,
@@ -129,6 +149,7 @@ pub use shp::{
     encode_region_shapefile, parse_shapefile_parts, read_region_shapefile, read_shapefile_parts,
     write_region_shapefile,
 };
+pub use solver::{foam_mesh, su2_text, write_openfoam, write_su2, FoamMesh};
 pub use surface::{
     parse_obj, parse_off, read_obj, read_off, write_obj_hexes, write_obj_quads, write_off_hexes,
     write_off_quads, SurfaceMesh,

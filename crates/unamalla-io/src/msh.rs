@@ -39,7 +39,9 @@ use std::collections::{BTreeMap, HashMap};
 use std::io::{self, Write};
 use std::path::Path;
 
-use unamalla_mesh::{DVec2, DVec3, HasHexCells, HasQuadCells, HexMesh, QuadMesh, HEX_FACES};
+use unamalla_mesh::{
+    BlockMesh2, DVec2, DVec3, HasHexCells, HasNodes, HasQuadCells, HexMesh, QuadMesh, HEX_FACES,
+};
 
 use crate::atomic::atomic_write;
 use crate::error::IoError;
@@ -287,7 +289,53 @@ pub fn write_msh_quads<M: HasQuadCells + ?Sized>(
         })
         .collect();
     atomic_write(path, |w| {
-        write_msh(w, 2, &nodes, &cells, MSH_QUAD, domain, &gs, MSH_LINE)
+        write_msh(w, 2, &nodes, &cells, &[], MSH_QUAD, domain, &gs, MSH_LINE)
+    })
+}
+
+/// Writes a block-structured quad mesh as MSH 4.1 with **one surface entity per block**
+/// (entity tag = block index + 1, the block's cells in its own element block, in the global
+/// mesh's cell order), every surface in the physical group `domain` (tag 1) and in its own
+/// physical surface `block-<b>` (tags after the edge groups), and each [`EdgeGroup`] (node ids
+/// of the global mesh, e.g. from [`crate::patches::named_edge_groups`]) as a physical curve.
+/// [`read_msh`] reads it back as one quad mesh with the groups.
+pub fn write_msh_blocks(
+    path: impl AsRef<Path>,
+    mesh: &BlockMesh2,
+    domain: &str,
+    groups: &[EdgeGroup],
+) -> Result<(), IoError> {
+    let path = path.as_ref();
+    let global = mesh.global();
+    let nn = global.num_nodes();
+    let mut seen = Vec::new();
+    check_name(path, domain, &mut seen)?;
+    for g in groups {
+        check_name(path, &g.name, &mut seen)?;
+        check_ids(path, &g.name, &g.edges, nn)?;
+    }
+    let nodes: Vec<DVec3> = global
+        .nodes()
+        .iter()
+        .map(|p| DVec3::new(p.x, p.y, 0.0))
+        .collect();
+    let cells: Vec<Vec<usize>> = (0..global.num_quads())
+        .map(|c| global.quad(c).to_vec())
+        .collect();
+    let parts: Vec<usize> = mesh.blocks().iter().map(|b| b.num_quads()).collect();
+    let gs: Vec<(&str, Vec<Vec<usize>>)> = groups
+        .iter()
+        .map(|g| {
+            (
+                g.name.as_str(),
+                g.edges.iter().map(|e| e.to_vec()).collect(),
+            )
+        })
+        .collect();
+    atomic_write(path, |w| {
+        write_msh(
+            w, 2, &nodes, &cells, &parts, MSH_QUAD, domain, &gs, MSH_LINE,
+        )
     })
 }
 
@@ -320,7 +368,17 @@ pub fn write_msh_hexes<M: HasHexCells + ?Sized>(
         })
         .collect();
     atomic_write(path, |w| {
-        write_msh(w, 3, mesh.nodes(), &cells, MSH_HEX, domain, &gs, MSH_QUAD)
+        write_msh(
+            w,
+            3,
+            mesh.nodes(),
+            &cells,
+            &[],
+            MSH_HEX,
+            domain,
+            &gs,
+            MSH_QUAD,
+        )
     })
 }
 
@@ -344,25 +402,38 @@ fn write_msh(
     dim: usize,
     nodes: &[DVec3],
     cells: &[Vec<usize>],
+    parts: &[usize],
     cell_type: u32,
     domain: &str,
     groups: &[(&str, Vec<Vec<usize>>)],
     group_type: u32,
 ) -> io::Result<()> {
+    // `parts`: cell counts of consecutive cell entities (empty: one entity, no block groups)
+    let whole = [cells.len()];
+    let (parts, block_groups) = if parts.is_empty() {
+        (&whole[..], false)
+    } else {
+        (parts, true)
+    };
+    let nb = if block_groups { parts.len() } else { 0 };
     writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
-    writeln!(w, "$PhysicalNames\n{}", groups.len() + 1)?;
+    writeln!(w, "$PhysicalNames\n{}", groups.len() + 1 + nb)?;
     writeln!(w, "{dim} 1 \"{domain}\"")?;
     for (k, (name, _)) in groups.iter().enumerate() {
         writeln!(w, "{} {} \"{name}\"", dim - 1, k + 2)?;
+    }
+    for b in 0..nb {
+        writeln!(w, "{dim} {} \"block-{b}\"", groups.len() + 2 + b)?;
     }
     writeln!(w, "$EndPhysicalNames")?;
     // Entities: (points, curves, surfaces, volumes).
     writeln!(w, "$Entities")?;
     let ng = groups.len();
+    let np = parts.len();
     if dim == 2 {
-        writeln!(w, "0 {ng} 1 0")?;
+        writeln!(w, "0 {ng} {np} 0")?;
     } else {
-        writeln!(w, "0 0 {ng} 1")?;
+        writeln!(w, "0 0 {ng} {np}")?;
     }
     let fmt_box = |(lo, hi): (DVec3, DVec3)| {
         format!(
@@ -374,7 +445,17 @@ fn write_msh(
         let b = bbox(nodes, elems.iter().flatten().copied());
         writeln!(w, "{} {} 1 {} 0", k + 1, fmt_box(b), k + 2)?;
     }
-    writeln!(w, "1 {} 1 1 0", fmt_box(bbox(nodes, 0..nodes.len())))?;
+    let mut start = 0;
+    for (b, &len) in parts.iter().enumerate() {
+        let cb = &cells[start..start + len];
+        let bx = bbox(nodes, cb.iter().flatten().copied());
+        if block_groups {
+            writeln!(w, "{} {} 2 1 {} 0", b + 1, fmt_box(bx), ng + 2 + b)?;
+        } else {
+            writeln!(w, "1 {} 1 1 0", fmt_box(bbox(nodes, 0..nodes.len())))?;
+        }
+        start += len;
+    }
     writeln!(w, "$EndEntities")?;
     let nn = nodes.len();
     writeln!(w, "$Nodes\n1 {nn} {} {nn}", nn.min(1))?;
@@ -387,7 +468,7 @@ fn write_msh(
     }
     writeln!(w, "$EndNodes")?;
     let total = cells.len() + groups.iter().map(|g| g.1.len()).sum::<usize>();
-    writeln!(w, "$Elements\n{} {total} {} {total}", ng + 1, total.min(1))?;
+    writeln!(w, "$Elements\n{} {total} {} {total}", ng + np, total.min(1))?;
     let mut tag = 0usize;
     let mut block = |w: &mut dyn Write, edim: usize, ent: usize, ty: u32, els: &[Vec<usize>]| {
         writeln!(w, "{edim} {ent} {ty} {}", els.len())?;
@@ -401,7 +482,11 @@ fn write_msh(
         }
         io::Result::Ok(())
     };
-    block(w, dim, 1, cell_type, cells)?;
+    let mut start = 0;
+    for (b, &len) in parts.iter().enumerate() {
+        block(w, dim, b + 1, cell_type, &cells[start..start + len])?;
+        start += len;
+    }
     for (k, (_, elems)) in groups.iter().enumerate() {
         block(w, dim - 1, k + 1, group_type, elems)?;
     }

@@ -1,0 +1,360 @@
+//! Checks before the work starts (issue #24): sizes against a memory limit, and the region
+//! features that make a stage fail with an internal message.
+//!
+//! **Memory.** Every size option and every count derived from one is turned into an estimate
+//! of the bytes it implies, `bytes = count × cost`, and compared with a limit *before* anything
+//! is allocated, so `--cells 1000000000` is an error naming the option, not an allocation abort
+//! after minutes. The per-unit costs ([`COST_PER_MESH_CELL`], …) are measured peak resident
+//! sizes divided by the count (docs/reliability.md, "Memory costs"), rounded up. The limit is
+//! [`DEFAULT_MEMORY_LIMIT`] (4 GiB), or the environment variable [`MEMORY_LIMIT_ENV`]
+//! (`UNAMALLA_MAX_MEMORY`, bytes with an optional `K`/`M`/`G`/`T` suffix, powers of 1024). A
+//! fixed documented limit rather than the machine's free memory keeps the answer for the same
+//! input and options the same on every machine and under any load.
+//!
+//! **Unsimplified huge rings.** Decomposition of a region with more than
+//! [`MAX_UNSIMPLIFIED_VERTICES`] vertices without simplification is refused with the vertex
+//! count: the decomposition's candidate scans are quadratic in the vertex count (measured:
+//! docs/reliability.md), so such a run would not end in reasonable time.
+//!
+//! **Gaps between rings.** A hole closer to the outer ring (or to another hole) than the
+//! merge tolerance of block nodes cannot be meshed at all, and one much closer than a cell
+//! cannot be meshed with cells of that size: the stages then fail with internal messages
+//! ("edge between global nodes 0 and 0 is shared by more than two cells"). [`ring_gaps`]
+//! finds the closest pair of distinct rings; [`explain_failure`] turns a stage failure into a
+//! message naming the hole, the gap and what to do when such a gap exists.
+
+use std::fmt;
+
+use unamalla_mesh::geometry::point_segment_distance;
+use unamalla_mesh::{DVec2, Region, SegmentIndex};
+
+use crate::CoreError;
+
+/// The default memory limit: 4 GiB.
+pub const DEFAULT_MEMORY_LIMIT: u64 = 4 << 30;
+
+/// Environment variable overriding [`DEFAULT_MEMORY_LIMIT`].
+pub const MEMORY_LIMIT_ENV: &str = "UNAMALLA_MAX_MEMORY";
+
+/// Peak bytes per cell of `unamalla mesh` (all stages, the smoother's Hessian dominates).
+pub const COST_PER_MESH_CELL: f64 = 12_000.0;
+/// Peak bytes per node of `unamalla tfi` (the grid, its quality arrays, the VTK text).
+pub const COST_PER_TFI_NODE: f64 = 400.0;
+/// Peak bytes per node of `unamalla hex` (the grid, the untangling/planarity Hessian).
+pub const COST_PER_HEX_NODE: f64 = 6_000.0;
+/// Peak bytes per control point of `unamalla bspline` (the net, its certificates, exports).
+pub const COST_PER_BSPLINE_NET_POINT: f64 = 2_000.0;
+/// Peak bytes per node of a quad mesh read from a file and smoothed or solved on.
+pub const COST_PER_SMOOTH_NODE: f64 = 12_000.0;
+
+/// Above this many vertices, a region is not decomposed without simplification.
+pub const MAX_UNSIMPLIFIED_VERTICES: usize = 200_000;
+
+/// A gap between distinct rings below this fraction of the cell size is named as the cause
+/// when a stage fails (and is the suggested lower bound on the cell size otherwise).
+pub const MIN_GAP_FRACTION: f64 = 0.01;
+
+/// Errors of the checks before the work.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PreflightError {
+    /// A size needs more memory than the limit.
+    #[error(
+        "{option} {value}: needs about {} ({count:.3e} {unit} × {cost} bytes), above the memory limit of {} \
+         (set {MEMORY_LIMIT_ENV} to raise it)",
+        human(*needed), human(*limit as f64)
+    )]
+    TooLarge {
+        /// The option (`--cells`, `--size`, …).
+        option: String,
+        /// Its value as given.
+        value: String,
+        /// The count the estimate is based on.
+        count: f64,
+        /// What is counted ("cells", "nodes", …).
+        unit: String,
+        /// Bytes per unit.
+        cost: f64,
+        /// Estimated bytes.
+        needed: f64,
+        /// The limit in bytes.
+        limit: u64,
+    },
+    /// `UNAMALLA_MAX_MEMORY` does not parse.
+    #[error("{MEMORY_LIMIT_ENV}={0}: expected a byte count like 8G, 512M or 1000000")]
+    BadLimit(String),
+    /// A huge ring without simplification.
+    #[error(
+        "the region has {vertices} vertices; without simplification at most {max} are decomposed \
+         (the decomposition's candidate scans grow quadratically); simplify first (drop --no-simplify, \
+         or run `unamalla simplify`)"
+    )]
+    TooManyVertices {
+        /// Vertices of the region.
+        vertices: usize,
+        /// [`MAX_UNSIMPLIFIED_VERTICES`].
+        max: usize,
+    },
+    /// A failure explained by a too-narrow gap between rings.
+    #[error(
+        "{} is {gap:.3e} from {}, below the meshable gap of {need:.3e} ({MIN_GAP_FRACTION} × the cell size {h:.3e}); \
+         use a smaller cell size (--cell-size ≤ {:.3e}), drop the hole (--min-hole-area), or move it \
+         (the stage reported: {detail})",
+        ring_name(*b), ring_name(*a), gap / MIN_GAP_FRACTION
+    )]
+    NarrowGap {
+        /// The first ring (0 = outer, k ≥ 1 = hole k − 1).
+        a: usize,
+        /// The second ring.
+        b: usize,
+        /// Their distance.
+        gap: f64,
+        /// The cell size.
+        h: f64,
+        /// `MIN_GAP_FRACTION · h`.
+        need: f64,
+        /// The stage's own message.
+        detail: String,
+    },
+}
+
+fn ring_name(k: usize) -> String {
+    if k == 0 {
+        "the outer ring".to_string()
+    } else {
+        format!("hole {}", k - 1)
+    }
+}
+
+/// `1536` → `"1.5 KiB"`.
+pub fn human(b: f64) -> String {
+    let units = ["bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
+    let mut v = b;
+    let mut k = 0;
+    while v >= 1024.0 && k + 1 < units.len() {
+        v /= 1024.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{v:.0} bytes")
+    } else {
+        format!("{v:.1} {}", units[k])
+    }
+}
+
+/// Parses `8G`, `512M`, `1000000` (powers of 1024).
+pub fn parse_bytes(s: &str) -> Option<u64> {
+    let t = s.trim();
+    let (num, mult) = match t.chars().last()?.to_ascii_uppercase() {
+        'K' => (&t[..t.len() - 1], 1u64 << 10),
+        'M' => (&t[..t.len() - 1], 1 << 20),
+        'G' => (&t[..t.len() - 1], 1 << 30),
+        'T' => (&t[..t.len() - 1], 1 << 40),
+        _ => (t, 1),
+    };
+    let v: f64 = num.trim().parse().ok()?;
+    (v.is_finite() && v > 0.0 && v * (mult as f64) < 1.8e19).then(|| (v * mult as f64) as u64)
+}
+
+/// The memory limit: [`MEMORY_LIMIT_ENV`] if set, else [`DEFAULT_MEMORY_LIMIT`].
+pub fn memory_limit() -> Result<u64, PreflightError> {
+    match std::env::var(MEMORY_LIMIT_ENV) {
+        Ok(s) => parse_bytes(&s).ok_or(PreflightError::BadLimit(s)),
+        Err(_) => Ok(DEFAULT_MEMORY_LIMIT),
+    }
+}
+
+/// `count × cost` against `limit`; the error names `option` and `value`.
+pub fn check_size(
+    option: &str,
+    value: impl fmt::Display,
+    count: f64,
+    unit: &str,
+    cost: f64,
+    limit: u64,
+) -> Result<(), PreflightError> {
+    let needed = count * cost;
+    if needed.is_finite() && needed <= limit as f64 {
+        Ok(())
+    } else {
+        Err(PreflightError::TooLarge {
+            option: option.to_string(),
+            value: value.to_string(),
+            count,
+            unit: unit.to_string(),
+            cost,
+            needed,
+            limit,
+        })
+    }
+}
+
+/// Refuses a region of more than [`MAX_UNSIMPLIFIED_VERTICES`] vertices that is to be
+/// decomposed as given.
+pub fn check_unsimplified(region: &Region) -> Result<(), PreflightError> {
+    let v = region.num_vertices();
+    if v > MAX_UNSIMPLIFIED_VERTICES {
+        Err(PreflightError::TooManyVertices {
+            vertices: v,
+            max: MAX_UNSIMPLIFIED_VERTICES,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// The closest pair of distinct rings `(a, b, distance)` (rings numbered as in
+/// [`PreflightError::NarrowGap`]), or `None` without holes. Uses the region's segment index:
+/// for every vertex, the edges of other rings within the current best distance.
+pub fn ring_gaps(region: &Region) -> Option<(usize, usize, f64)> {
+    if region.holes().is_empty() {
+        return None;
+    }
+    let rings: Vec<Vec<DVec2>> = region.rings().map(|r| r.points().to_vec()).collect();
+    // brute force over ring pairs is O(n²) only in the holes' vertices against the rest;
+    // bound the work with the segment index's box queries instead
+    let index = SegmentIndex::new(rings.clone());
+    let mut best: Option<(usize, usize, f64)> = None;
+    // holes first (usually small and near something): the best distance shrinks early, and the
+    // outer ring's vertices then query small boxes
+    for ra in (1..rings.len()).chain([0]) {
+        for &p in &rings[ra] {
+            let r = best.map_or_else(
+                || {
+                    let (lo, hi) = region.bounding_box();
+                    (hi - lo).length()
+                },
+                |b| b.2,
+            );
+            let d = DVec2::splat(r);
+            for e in index.candidates(p - d, p + d) {
+                if e.ring == ra {
+                    continue;
+                }
+                let (a, b) = index.edge(e);
+                let dist = point_segment_distance(p, a, b);
+                if best.is_none_or(|x| dist < x.2) {
+                    best = Some((ra.min(e.ring), ra.max(e.ring), dist));
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Replaces a stage failure `e` by [`PreflightError::NarrowGap`] when `region` has two rings
+/// closer than [`MIN_GAP_FRACTION`] × `h`; other errors pass unchanged. Guarantee and
+/// preflight errors are never replaced.
+pub fn explain_failure(e: CoreError, region: &Region, h: f64) -> CoreError {
+    if matches!(e, CoreError::Guarantee(_) | CoreError::Preflight(_)) || !(h > 0.0) {
+        return e;
+    }
+    match ring_gaps(region) {
+        Some((a, b, gap)) if gap < MIN_GAP_FRACTION * h => {
+            CoreError::Preflight(PreflightError::NarrowGap {
+                a,
+                b,
+                gap,
+                h,
+                need: MIN_GAP_FRACTION * h,
+                detail: e.to_string(),
+            })
+        }
+        _ => e,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_compared_with_the_limit() {
+        // 10⁹ cells × 12,000 bytes = 1.2e13 bytes ≈ 10.9 TiB > 4 GiB
+        let e = check_size(
+            "--cells",
+            1_000_000_000u64,
+            1e9,
+            "cells",
+            COST_PER_MESH_CELL,
+            DEFAULT_MEMORY_LIMIT,
+        )
+        .unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.starts_with("--cells 1000000000: needs about 10.9 TiB"),
+            "{s}"
+        );
+        assert!(s.contains("above the memory limit of 4.0 GiB"), "{s}");
+        assert!(s.contains(MEMORY_LIMIT_ENV), "{s}");
+        // 20,000 cells: 240 MB, fine
+        check_size(
+            "--cells",
+            20000,
+            2e4,
+            "cells",
+            COST_PER_MESH_CELL,
+            DEFAULT_MEMORY_LIMIT,
+        )
+        .unwrap();
+        // an overflowing count (inf) is too large, not accepted
+        assert!(check_size("--size", "x", f64::INFINITY, "nodes", 1.0, u64::MAX).is_err());
+    }
+
+    #[test]
+    fn byte_counts_parse() {
+        assert_eq!(parse_bytes("8G"), Some(8 << 30));
+        assert_eq!(parse_bytes("512m"), Some(512 << 20));
+        assert_eq!(parse_bytes("1000000"), Some(1_000_000));
+        assert_eq!(parse_bytes("1.5K"), Some(1536));
+        assert_eq!(parse_bytes("-1G"), None);
+        assert_eq!(parse_bytes("lots"), None);
+        assert_eq!(parse_bytes(""), None);
+        assert_eq!(human(1536.0), "1.5 KiB");
+        assert_eq!(human((4u64 << 30) as f64), "4.0 GiB");
+    }
+
+    #[test]
+    fn the_closest_rings_are_found() {
+        // square [0,10]², holes: [1,2]×[1,2] (gap 1 to the outer ring) and
+        // [2.5,3]×[1,2] (gap 0.5 to the first hole)
+        let sq = |x0: f64, y0: f64, x1: f64, y1: f64| {
+            vec![
+                DVec2::new(x0, y0),
+                DVec2::new(x0, y1),
+                DVec2::new(x1, y1),
+                DVec2::new(x1, y0),
+            ]
+        };
+        let outer = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 0.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ];
+        let r = Region::new(
+            outer.clone(),
+            vec![sq(1.0, 1.0, 2.0, 2.0), sq(2.5, 1.0, 3.0, 2.0)],
+        )
+        .unwrap();
+        assert_eq!(ring_gaps(&r), Some((1, 2, 0.5)));
+        let r = Region::new(outer.clone(), vec![sq(1e-9, 1.0, 2.0, 2.0)]).unwrap();
+        let (a, b, g) = ring_gaps(&r).unwrap();
+        assert_eq!((a, b), (0, 1));
+        assert!((g - 1e-9).abs() < 1e-15, "{g}");
+        let e = explain_failure(
+            CoreError::Unsupported("edge between global nodes 0 and 0".into()),
+            &r,
+            0.1,
+        );
+        let s = e.to_string();
+        assert!(
+            s.starts_with("hole 0 is 1.000e-9 from the outer ring"),
+            "{s}"
+        );
+        assert!(s.contains("edge between global nodes 0 and 0"), "{s}");
+        // a wide gap leaves the error alone
+        let r = Region::new(outer, vec![sq(1.0, 1.0, 2.0, 2.0)]).unwrap();
+        let e = explain_failure(CoreError::Unsupported("x".into()), &r, 0.1);
+        assert_eq!(e.to_string(), "x");
+    }
+}
