@@ -8,7 +8,9 @@
 //! ```
 //!
 //! Candidates (`UNAMALLA_STUDY=name,name` selects some):
-//! * `converged` — [`default_smooth_options`] (window FTOL + quality plateau, cap 1000);
+//! * `default` — [`default_smooth_options`] (σ = 0.5 first stage, then σ = 0.1 with window
+//!   FTOL + quality plateau, cap 1000);
+//! * `converged` — σ = 0.1 alone with the same stop rules;
 //! * `cap1000` — the stop rules off (FTOL 10⁻¹⁰, GTOL 10⁻⁶, cap 1000): what the old
 //!   smoother reached after 1000 iterations without its clock;
 //! * `plateau` — the quality plateau alone (no window FTOL);
@@ -33,10 +35,11 @@ fn cpu_seconds() -> f64 {
 }
 
 fn candidates() -> Vec<(&'static str, SmoothOptions)> {
-    let conv = default_smooth_options();
-    let mut cap = default_smooth_options();
+    let mut conv = default_smooth_options();
+    conv.sigma_continuation.clear();
+    let mut cap = conv.clone();
     cap.solver.stop = StopRules::default();
-    let mut plateau = default_smooth_options();
+    let mut plateau = conv.clone();
     plateau.solver.stop.window_ftol = 0.0;
     let mut s1 = default_smooth_options();
     s1.sigma_continuation = vec![1.0];
@@ -45,6 +48,7 @@ fn candidates() -> Vec<(&'static str, SmoothOptions)> {
     s05.sigma_continuation = vec![0.5];
     s05.continuation_iter = 30;
     let all = vec![
+        ("default", default_smooth_options()),
         ("converged", conv),
         ("cap1000", cap),
         ("plateau", plateau),

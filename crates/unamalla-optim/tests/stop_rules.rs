@@ -234,3 +234,30 @@ fn an_explicit_time_limit_is_its_own_status_never_by_user() {
         }
     }
 }
+
+#[test]
+fn sigma_continuation_runs_its_stage_first_and_rejects_a_bad_sigma() {
+    // a first stage at σ = 0.5 capped at 3 iterations: the classic-phase monitors start with
+    // exactly three iterates of that stage (their F differs from the σ = 0.1 run's start)
+    let mut o = opts(StopRules::default(), 5);
+    o.sigma_continuation = vec![0.5];
+    o.continuation_iter = 3;
+    let mut h = HistoryObserver::default();
+    let rep = smooth(&mut grid(), &o, &mut h).unwrap();
+    assert_eq!(rep.iter_classic, 3 + 5, "{rep:?}");
+    assert!(rep.convex);
+    let (plain, _) = run(StopRules::default(), 5);
+    assert_ne!(
+        h.history[0].f, plain[0].f,
+        "the first iterate is the σ = 0.5 stage's"
+    );
+    for bad in [-0.1, 1.5, f64::NAN] {
+        o.sigma_continuation = vec![bad];
+        match smooth(&mut grid(), &o, &mut HistoryObserver::default()) {
+            Err(unamalla_optim::OptimError::InvalidOption { name, .. }) => {
+                assert_eq!(name, "sigma_continuation")
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+}
