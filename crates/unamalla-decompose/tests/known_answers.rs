@@ -4,6 +4,15 @@
 use unamalla_decompose::{decompose, DecomposeOptions, Decomposition, EdgeKind, Tolerances};
 use unamalla_mesh::{DVec2, Region};
 
+/// The thesis's layout (Algorithm 1 alone): these known answers are the thesis's
+/// (the chord layout, the default, may cut a triangle or a strip across first).
+fn thesis() -> DecomposeOptions {
+    DecomposeOptions {
+        layout: unamalla_decompose::Layout::Concavity,
+        ..DecomposeOptions::default()
+    }
+}
+
 fn v(x: f64, y: f64) -> DVec2 {
     DVec2::new(x, y)
 }
@@ -80,7 +89,7 @@ fn check_tiling(region: &Region, d: &Decomposition) {
 #[test]
 fn convex_quadrilateral_stays_one_block() {
     let r = Region::new(vec![v(0., 0.), v(4., 0.5), v(3.5, 3.), v(0.2, 2.5)], vec![]).unwrap();
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     assert_eq!(d.blocks.len(), 1);
     assert!(d.cuts.is_empty());
     let mut c = d.blocks[0].corners;
@@ -97,7 +106,7 @@ fn square_with_square_hole_gets_at_least_four_blocks() {
         vec![vec![v(4., 4.), v(6., 4.), v(6., 6.), v(4., 6.)]],
     )
     .unwrap();
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     assert!(d.blocks.len() >= 4, "{} blocks", d.blocks.len());
     check_tiling(&r, &d);
     // the hole boundary is split among the blocks: every hole edge is on some block
@@ -154,7 +163,7 @@ fn expected_triangle_corners(t: &[DVec2], critical: &[usize]) -> Vec<DVec2> {
 fn assert_triangle_block(angles: (f64, f64), critical: &[usize]) {
     let t = triangle(angles.0, angles.1);
     let r = Region::new(t.clone(), vec![]).unwrap();
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     assert_eq!(d.blocks.len(), 1, "a triangle is a leaf");
     let b = &d.blocks[0];
     assert!(b.triangle);
@@ -198,7 +207,7 @@ fn rhombus_with_three_holes() -> Region {
 #[test]
 fn rhombus_with_three_holes_is_admissible() {
     let r = rhombus_with_three_holes();
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     check_tiling(&r, &d);
     let tol = Tolerances::default();
     for b in &d.blocks {
@@ -250,7 +259,7 @@ fn result_does_not_depend_on_ring_numbering() {
     };
     let base = {
         let r = Region::new(outer.clone(), vec![hole.clone()]).unwrap();
-        let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+        let d = decompose(&r, &thesis()).unwrap();
         check_tiling(&r, &d);
         (d.blocks.len(), cut_set(&d))
     };
@@ -260,7 +269,7 @@ fn result_does_not_depend_on_ring_numbering() {
         let mut h = hole.clone();
         h.rotate_left(shift % 4);
         let r = Region::new(o, vec![h]).unwrap();
-        let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+        let d = decompose(&r, &thesis()).unwrap();
         assert_eq!(d.blocks.len(), base.0, "shift {shift}");
         let cs = cut_set(&d);
         assert_eq!(cs.len(), base.1.len());
@@ -279,7 +288,7 @@ fn result_does_not_depend_on_ring_numbering() {
 #[test]
 fn side_curves_cover_the_ring_and_separate_cuts() {
     let r = rhombus_with_three_holes();
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     for b in &d.blocks {
         let sides = b.side_curves();
         let edges: usize = sides.iter().flatten().map(|q| q.points.len() - 1).sum();
@@ -378,14 +387,14 @@ fn a_spike_tip_gets_a_cut_so_no_block_keeps_it() {
     )
     .unwrap();
     // without the spike criterion the square stays one block with the tip inside a side
-    let mut opts = DecomposeOptions::default();
+    let mut opts = thesis();
     opts.tolerances.theta_plus = std::f64::consts::TAU;
     let d = decompose(&r, &opts).unwrap();
     assert_eq!(d.blocks.len(), 1);
     let expected = 360.0 - 2.0 * (0.1f64 / 6.0).atan().to_degrees();
     assert!((largest_block_angle(&d) - expected).abs() < 1e-9);
     // with it a cut starts at the tip and leaves two angles ≤ 180° there
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     check_tiling(&r, &d);
     assert!(
         largest_block_angle(&d) <= 180.0,
@@ -407,7 +416,7 @@ fn a_sliver_island_keeps_no_spike_in_any_block() {
     )
     .unwrap();
     let tip = v(20., 50.);
-    let d = decompose(&r, &DecomposeOptions::default()).unwrap();
+    let d = decompose(&r, &thesis()).unwrap();
     check_tiling(&r, &d);
     let theta_plus = Tolerances::default().theta_plus.to_degrees();
     assert!(largest_block_angle(&d) <= theta_plus);

@@ -1,0 +1,55 @@
+//! Issue #22 item 2: the layout predictor ([`unamalla_core::predict`]) correlates with the
+//! quality the finished mesh reaches, block by block. `MeshReport::block_quality` holds both
+//! numbers per block; the cell-weighted Pearson correlation over the blocks of a real region
+//! must be clearly positive (≥ 0.5: the prediction explains at least a quarter of the
+//! variance of the achieved per-block share).
+
+use std::path::Path;
+
+use unamalla_core::io::{self, PartSelector};
+use unamalla_core::pipeline::Mesher;
+
+fn correlation(v: &[(f64, f64, f64)]) -> f64 {
+    let w: f64 = v.iter().map(|x| x.2).sum();
+    let mx = v.iter().map(|x| x.0 * x.2).sum::<f64>() / w;
+    let my = v.iter().map(|x| x.1 * x.2).sum::<f64>() / w;
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for &(x, y, c) in v {
+        sxy += c * (x - mx) * (y - my);
+        sxx += c * (x - mx) * (x - mx);
+        syy += c * (y - my) * (y - my);
+    }
+    sxy / (sxx * syy).sqrt()
+}
+
+#[test]
+fn correlation_of_a_perfect_and_an_inverted_prediction() {
+    let v = [(10.0, 20.0, 1.0), (20.0, 40.0, 2.0), (30.0, 60.0, 1.0)];
+    assert!((correlation(&v) - 1.0).abs() < 1e-12);
+    let u = [(10.0, 60.0, 1.0), (20.0, 40.0, 2.0), (30.0, 20.0, 1.0)];
+    assert!((correlation(&u) + 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn the_layout_predictor_correlates_with_the_achieved_quality() {
+    for name in ["puget-sound", "sakhalin"] {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/regions")
+            .join(format!("{name}.geojson"));
+        let region = io::read_region_geojson(p, PartSelector::Largest).unwrap();
+        let r = Mesher::new().cells(6_000).mesh(&region).unwrap();
+        let v: Vec<(f64, f64, f64)> = r
+            .report
+            .block_quality
+            .iter()
+            .map(|b| (b.predicted, b.achieved, b.cells as f64))
+            .collect();
+        assert!(v.len() >= 5, "{name}: {} blocks with a prediction", v.len());
+        let c = correlation(&v);
+        eprintln!(
+            "{name}: per-block correlation {c:.3} over {} blocks",
+            v.len()
+        );
+        assert!(c >= 0.5, "{name}: correlation {c:.3}");
+    }
+}
