@@ -126,7 +126,7 @@ fn main() {
                     Some(c) => (c.predicted_percent, format!("{:?}", c.candidates)),
                     None => (f64::NAN, String::new()),
                 };
-                let corr = correlation(
+                let corr = unamalla_core::predict::weighted_correlation(
                     &rep.block_quality
                         .iter()
                         .map(|b| (b.predicted, b.achieved, b.cells as f64))
@@ -150,21 +150,4 @@ fn main() {
             ),
         }
     }
-}
-
-/// Cell-weighted Pearson correlation of (predicted, achieved) per block.
-fn correlation(v: &[(f64, f64, f64)]) -> f64 {
-    let w: f64 = v.iter().map(|x| x.2).sum();
-    if v.len() < 3 || w <= 0.0 {
-        return f64::NAN;
-    }
-    let mx = v.iter().map(|x| x.0 * x.2).sum::<f64>() / w;
-    let my = v.iter().map(|x| x.1 * x.2).sum::<f64>() / w;
-    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
-    for &(x, y, c) in v {
-        sxy += c * (x - mx) * (y - my);
-        sxx += c * (x - mx) * (x - mx);
-        syy += c * (y - my) * (y - my);
-    }
-    sxy / (sxx * syy).sqrt()
 }

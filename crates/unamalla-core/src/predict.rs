@@ -152,3 +152,22 @@ pub fn predict_mesh(d: &Decomposition, size: MeshSize) -> Result<Prediction, Cor
         singularities,
     })
 }
+
+/// Weighted Pearson correlation of `(x, y, weight)` triples (NaN with fewer than two distinct
+/// points or zero weight): how `MeshReport::block_quality` predictions track the achieved
+/// shares, weighted by the blocks' cells.
+pub fn weighted_correlation(v: &[(f64, f64, f64)]) -> f64 {
+    let w: f64 = v.iter().map(|x| x.2).sum();
+    if w <= 0.0 {
+        return f64::NAN;
+    }
+    let mx = v.iter().map(|x| x.0 * x.2).sum::<f64>() / w;
+    let my = v.iter().map(|x| x.1 * x.2).sum::<f64>() / w;
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for &(x, y, c) in v {
+        sxy += c * (x - mx) * (y - my);
+        sxx += c * (x - mx) * (x - mx);
+        syy += c * (y - my) * (y - my);
+    }
+    sxy / (sxx * syy).sqrt()
+}

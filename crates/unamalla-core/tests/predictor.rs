@@ -8,19 +8,7 @@ use std::path::Path;
 
 use unamalla_core::io::{self, PartSelector};
 use unamalla_core::pipeline::Mesher;
-
-fn correlation(v: &[(f64, f64, f64)]) -> f64 {
-    let w: f64 = v.iter().map(|x| x.2).sum();
-    let mx = v.iter().map(|x| x.0 * x.2).sum::<f64>() / w;
-    let my = v.iter().map(|x| x.1 * x.2).sum::<f64>() / w;
-    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
-    for &(x, y, c) in v {
-        sxy += c * (x - mx) * (y - my);
-        sxx += c * (x - mx) * (x - mx);
-        syy += c * (y - my) * (y - my);
-    }
-    sxy / (sxx * syy).sqrt()
-}
+use unamalla_core::predict::weighted_correlation as correlation;
 
 #[test]
 fn correlation_of_a_perfect_and_an_inverted_prediction() {

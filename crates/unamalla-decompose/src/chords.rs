@@ -580,17 +580,18 @@ pub(crate) fn layout_cuts(
         }
         // a bridge on no cycle would leave one block on both of its sides: drop it with the
         // rings hanging from it (Algorithm 2 removes those holes later)
-        let mut detached = vec![false; nr];
-        for r in 1..nr {
-            let mut x = r;
-            while let Some((px, e)) = up[x] {
-                if !covered[e] {
-                    detached[r] = true;
-                    break;
+        let detached: Vec<bool> = (0..nr)
+            .map(|r| {
+                let mut x = r;
+                while let Some((px, e)) = up[x] {
+                    if !covered[e] {
+                        return true;
+                    }
+                    x = px;
                 }
-                x = px;
-            }
-        }
+                false
+            })
+            .collect();
         order.retain(|&(a, b)| !detached[m.ring[a]] && !detached[m.ring[b]]);
         for &(a, b) in &order {
             cut_set.insert((a.min(b), a.max(b)));
@@ -704,9 +705,9 @@ mod tests {
         .expect("rectangle")
     }
 
-    #[test]
-    fn the_inside_triangles_cover_the_region() {
-        let r = Region::new(
+    /// The 4 × 4 square with a 2 × 2 square hole in its middle (area 12, gap 1).
+    fn square_with_hole() -> Region {
+        Region::new(
             vec![
                 DVec2::new(0.0, 0.0),
                 DVec2::new(4.0, 0.0),
@@ -720,7 +721,12 @@ mod tests {
                 DVec2::new(3.0, 1.0),
             ]],
         )
-        .expect("square with a hole");
+        .expect("square with a hole")
+    }
+
+    #[test]
+    fn the_inside_triangles_cover_the_region() {
+        let r = square_with_hole();
         let m = ChordMesh::new(&r, 0.5).expect("triangulation");
         let a: f64 = (0..m.tris.len()).map(|t| m.tri_area(t)).sum();
         assert!((a - 12.0).abs() < 1e-9, "area {a}");
@@ -785,21 +791,7 @@ mod tests {
 
     #[test]
     fn a_hole_gets_two_bridges_that_split_it() {
-        let r = Region::new(
-            vec![
-                DVec2::new(0.0, 0.0),
-                DVec2::new(4.0, 0.0),
-                DVec2::new(4.0, 4.0),
-                DVec2::new(0.0, 4.0),
-            ],
-            vec![vec![
-                DVec2::new(1.0, 1.0),
-                DVec2::new(1.0, 3.0),
-                DVec2::new(3.0, 3.0),
-                DVec2::new(3.0, 1.0),
-            ]],
-        )
-        .expect("square with a hole");
+        let r = square_with_hole();
         let cuts = layout_cuts(&r, 0.25, DEFAULT_ASPECT, 0.0).expect("cuts");
         assert!(cuts.len() >= 2, "{cuts:?}");
         // the first two are the bridge and its closing chord, each 1 long (the gap)
