@@ -90,19 +90,11 @@ fn main() {
             Ok(r) => {
                 let rep = &r.report;
                 if std::env::var_os("LAYOUT_SING").is_some() {
+                    use unamalla_core::mesh::quality::interior_singularities;
                     use unamalla_core::mesh::HasNodes;
                     let g = r.mesh.global();
-                    let bnd = g.boundary_flags();
-                    let mut val = vec![0usize; g.nodes().len()];
-                    for c in g.cells() {
-                        for &v in c {
-                            val[v] += 1;
-                        }
-                    }
-                    for (i, &v) in val.iter().enumerate() {
-                        if !bnd[i] && v != 4 {
-                            eprintln!("singular node {i} valence {v} at {:?}", g.nodes()[i]);
-                        }
+                    for (i, v) in interior_singularities(g).singular {
+                        eprintln!("singular node {i} valence {v} at {:?}", g.nodes()[i]);
                     }
                     for c in &r.decomposition.cuts {
                         eprintln!("cut {} {:?} {:?}", c.id, c.a, c.b);

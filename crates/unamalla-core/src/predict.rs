@@ -22,7 +22,7 @@
 //! the finished mesh reaches in that block.
 
 use unamalla_decompose::Decomposition;
-use unamalla_mesh::quality::mu;
+use unamalla_mesh::quality::{interior_singularities, mu};
 use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells};
 
 use crate::curves::{compatible_counts, decomposition_area};
@@ -46,21 +46,6 @@ pub struct Prediction {
     /// Interior nodes of the coarse mesh with valence ≠ 4 (a layout with cut joints, or one
     /// whose blocks do not merge conformally, has some; the pipeline's layouts should not).
     pub singularities: usize,
-}
-
-/// Interior nodes (not on the boundary of the union) with a valence other than 4.
-pub fn interior_singularities(mesh: &BlockMesh2) -> usize {
-    let g = mesh.global();
-    let boundary = g.boundary_flags();
-    let mut valence = vec![0usize; g.nodes().len()];
-    for c in g.cells() {
-        for &v in c {
-            valence[v] += 1;
-        }
-    }
-    (0..valence.len())
-        .filter(|&i| !boundary[i] && valence[i] != 4)
-        .count()
 }
 
 /// Share of the cells of block `b` of `mesh` (global node coordinates) with μ ≥ 0.8, and the
@@ -134,7 +119,7 @@ pub fn predict_mesh(d: &Decomposition, size: MeshSize) -> Result<Prediction, Cor
     let cc = compatible_counts(d, coarse)?;
     let grids = cc.curves.grids(d, &cc.solution.counts)?;
     let mut mesh = BlockMesh2::merge(grids, 1e-9)?;
-    let singularities = interior_singularities(&mesh);
+    let singularities = interior_singularities(mesh.global()).count();
     laplacian_sweeps(&mut mesh, PREDICT_SWEEPS);
     let mut good = 0.0;
     let mut total = 0usize;
