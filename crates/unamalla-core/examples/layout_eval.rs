@@ -68,8 +68,11 @@ fn main() {
                 unamalla_core::pipeline::MeshSize::Cells(cells),
             ) {
                 Ok((d, c)) => println!(
-                    "{{\"region\":\"{name}\",\"layout\":\"{}\",\"blocks\":{},\"cands\":\"{:?}\",\"seconds\":{:.2}}}",
+                    "{{\"region\":\"{name}\",\"layout\":\"{}\",\"pred\":{:.2},\"resplit\":\"{}/{}\",\"blocks\":{},\"cands\":\"{:?}\",\"seconds\":{:.2}}}",
                     c.layout,
+                    c.predicted_percent,
+                    c.resplit_cuts,
+                    c.resplit_tried,
                     d.blocks.len(),
                     c.candidates,
                     t.elapsed().as_secs_f64()
@@ -115,7 +118,13 @@ fn main() {
                     .map(|(s, t)| format!("\"{s:?}\":{t:.2}"))
                     .collect();
                 let (pred, cands) = match &rep.layout {
-                    Some(c) => (c.predicted_percent, format!("{:?}", c.candidates)),
+                    Some(c) => (
+                        c.predicted_percent,
+                        format!(
+                            "{} +{}/{} {:?}",
+                            c.layout, c.resplit_cuts, c.resplit_tried, c.candidates
+                        ),
+                    ),
                     None => (f64::NAN, String::new()),
                 };
                 let corr = unamalla_core::predict::weighted_correlation(

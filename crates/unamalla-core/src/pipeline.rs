@@ -56,7 +56,10 @@ use serde::Serialize;
 use unamalla_compat_ilp as ilp;
 use unamalla_contour::{remove_features_below, simplify_region, SimplifyOptions};
 use unamalla_decompose::submap::{prefers_submap, submap, SubmapOptions, Submapping};
-use unamalla_decompose::{chord_layout, decompose, DecomposeOptions, Decomposition, Layout};
+use unamalla_decompose::{
+    chord_layout_cuts, decompose, layout_from_cuts, split_chord, DecomposeOptions, Decomposition,
+    Layout,
+};
 use unamalla_mesh::quality::QualityReport;
 use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells, Region};
 use unamalla_optim::monitor::{NullObserver, Observer};
@@ -877,6 +880,23 @@ pub const LAYOUT_ASPECTS: [(&str, f64); 3] = [
     ("chords-1.5", 1.5),
 ];
 
+/// Predicted-quality re-split: at most this many candidate cuts are tried
+/// ([`choose_layout`]).
+pub const RESPLIT_EVALS: usize = 8;
+/// A block is a re-split candidate while its predicted μ ≥ 0.8 share is below this.
+pub const RESPLIT_BELOW: f64 = 0.9;
+/// Smallest chord score `min(A₁, A₂)/w²` of a re-split cut: the smaller part extends at
+/// least half a chord width beyond it (a half disc at its base scores π/8 ≈ 0.39, so a cape
+/// is not cut off).
+pub const RESPLIT_SCORE: f64 = 0.5;
+/// A re-split cut leaves at least this many cells of the requested size on its smaller side
+/// (a cut off a smaller feature cannot change the mesh beyond its few cells).
+pub const RESPLIT_CELLS: f64 = 16.0;
+/// A re-split cut is kept when it raises the predicted share of the whole mesh by at least
+/// this much (a fifth of a percentage point; the prediction resolves differences of that
+/// order between layouts that differ in one block).
+pub const RESPLIT_GAIN: f64 = 0.002;
+
 /// Which layout [`Mesher`] chose, and why.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LayoutChoice {
@@ -889,18 +909,64 @@ pub struct LayoutChoice {
     pub candidates: Vec<(String, f64)>,
     /// Predicted μ ≥ 0.8 share per block of the chosen layout.
     pub blocks: Vec<f64>,
+    /// Cuts added to the chosen layout by the predicted-quality re-split (each raised the
+    /// predicted share by at least [`RESPLIT_GAIN`]).
+    pub resplit_cuts: usize,
+    /// Candidate cuts the re-split evaluated (at most [`RESPLIT_EVALS`]).
+    pub resplit_tried: usize,
+}
+
+/// Rule breaks of a layout: interior singularities of its coarse mesh (cut joints, which the
+/// triangle-block rule makes when it must split a cut) plus blocks that are not admissible.
+fn rule_breaks(
+    d: &Decomposition,
+    p: &crate::predict::Prediction,
+    opts: &DecomposeOptions,
+) -> usize {
+    let bad: Vec<usize> = (0..d.blocks.len())
+        .filter(|&b| !d.block_admissible(b, &opts.tolerances))
+        .collect();
+    if std::env::var_os("UNAMALLA_LAYOUT_DEBUG").is_some() {
+        for &b in &bad {
+            let blk = &d.blocks[b];
+            let c = unamalla_decompose::concavity(&blk.ring);
+            let crit = unamalla_decompose::critical_angles(&blk.ring, opts.tolerances.theta_minus);
+            eprintln!(
+                "  inadmissible block {b}: {} vertices, area {:.4e}, triangle {}, convex {}, kappa {:.3} {:.3} {:.3} {:.3}, critical {:?} at {:?}",
+                blk.ring.len(),
+                blk.area(),
+                blk.triangle,
+                c.approximately_convex(&opts.tolerances),
+                c.kappa1, c.kappa2, c.kappa3, c.kappa4,
+                crit,
+                blk.ring.first()
+            );
+        }
+    }
+    p.singularities + bad.len()
 }
 
 /// Builds the concavity layout and the chord layouts of [`LAYOUT_ASPECTS`] of `region` and
 /// keeps the one with the highest predicted μ ≥ 0.8 share ([`crate::predict::predict_mesh`]):
-/// a layout with fewer rule breaks (interior singularities, non-admissible blocks) always wins, the concavity layout
-/// wins ties within [`LAYOUT_MARGIN`], then the one with fewer blocks.
+/// a layout with fewer rule breaks (interior singularities, non-admissible blocks) always
+/// wins, the concavity layout wins ties within [`LAYOUT_MARGIN`], then the one with fewer
+/// blocks.
+///
+/// A chosen chord layout is then **re-split by the prediction**: the block with the most
+/// predicted bad cells (`(1 − share)·cells`, share below [`RESPLIT_BELOW`]) that has a chord
+/// of score ≥ [`RESPLIT_SCORE`] between boundary points or layout cuts
+/// ([`unamalla_decompose::split_chord`]) gets it as one more layout cut; the layout is rebuilt
+/// ([`unamalla_decompose::layout_from_cuts`]) and predicted again, and the cut is kept when the
+/// predicted share rises by at least [`RESPLIT_GAIN`] without more rule breaks. At most
+/// [`RESPLIT_EVALS`] candidates are tried, so the work is bounded.
 pub fn choose_layout(
     region: &Region,
     opts: &DecomposeOptions,
     size: MeshSize,
 ) -> Result<(Decomposition, LayoutChoice), CoreError> {
-    let mut cands: Vec<(&str, Decomposition)> = Vec::new();
+    // (name, layout cuts for a chord layout, decomposition)
+    type Cand = (&'static str, Option<Vec<(DVec2, DVec2)>>, Decomposition);
+    let mut cands: Vec<Cand> = Vec::new();
     let conc = decompose(
         region,
         &DecomposeOptions {
@@ -910,7 +976,7 @@ pub fn choose_layout(
     );
     let conc_err = match conc {
         Ok(d) => {
-            cands.push(("concavity", d));
+            cands.push(("concavity", None, d));
             None
         }
         Err(e) => Some(e),
@@ -920,18 +986,16 @@ pub fn choose_layout(
             chord_aspect: aspect,
             ..opts.clone()
         };
-        if let Ok(d) = chord_layout(region, &o) {
-            if !cands.iter().any(|(_, c)| *c == d) {
-                cands.push((name, d));
+        if let Ok((cuts, d)) = chord_layout_cuts(region, &o) {
+            if !cands.iter().any(|(_, _, c)| *c == d) {
+                cands.push((name, Some(cuts), d));
             }
         }
     }
-    // key: fewer rule breaks (interior singularities — cut joints, which the triangle-block
-    // rule makes when it must split a cut — and blocks that are not admissible), then the
-    // predicted share, then fewer blocks
+    // key: fewer rule breaks, then the predicted share, then fewer blocks
     let mut best: Option<((usize, f64, usize), usize, crate::predict::Prediction)> = None;
     let mut scores = Vec::new();
-    for (k, (name, d)) in cands.iter().enumerate() {
+    for (k, (name, _, d)) in cands.iter().enumerate() {
         let Ok(p) = crate::predict::predict_mesh(d, size) else {
             continue;
         };
@@ -942,10 +1006,16 @@ pub fn choose_layout(
             } else {
                 0.0
             };
-        let inadmissible = (0..d.blocks.len())
-            .filter(|&b| !d.block_admissible(b, &opts.tolerances))
-            .count();
-        let key = (p.singularities + inadmissible, share, d.blocks.len());
+        let key = (rule_breaks(d, &p, opts), share, d.blocks.len());
+        if std::env::var_os("UNAMALLA_LAYOUT_DEBUG").is_some() {
+            eprintln!(
+                "layout {name}: {} blocks, predicted {:.2} %, {} singular nodes, {} rule breaks",
+                d.blocks.len(),
+                100.0 * p.good_share,
+                p.singularities,
+                key.0
+            );
+        }
         let better = match &best {
             None => true,
             Some((bk, _, _)) => {
@@ -958,23 +1028,41 @@ pub fn choose_layout(
     }
     match best {
         Some((_, k, p)) => {
-            let (name, d) = cands.swap_remove(k);
+            let (name, cuts, d) = cands.swap_remove(k);
+            let aspect = LAYOUT_ASPECTS
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, a)| *a);
+            let (d, p, added, tried) = match (cuts, aspect) {
+                (Some(cuts), Some(aspect)) => {
+                    let o = DecomposeOptions {
+                        chord_aspect: aspect,
+                        ..opts.clone()
+                    };
+                    resplit(region, &o, size, cuts, d, p)
+                }
+                _ => (d, p, 0, 0),
+            };
             let choice = LayoutChoice {
                 layout: name.to_string(),
                 predicted_percent: 100.0 * p.good_share,
                 candidates: scores,
                 blocks: p.blocks,
+                resplit_cuts: added,
+                resplit_tried: tried,
             };
             Ok((d, choice))
         }
         None => match cands.pop() {
-            Some((name, d)) => Ok((
+            Some((name, _, d)) => Ok((
                 d,
                 LayoutChoice {
                     layout: name.to_string(),
                     predicted_percent: f64::NAN,
                     candidates: scores,
                     blocks: Vec::new(),
+                    resplit_cuts: 0,
+                    resplit_tried: 0,
                 },
             )),
             None => Err(conc_err
@@ -982,6 +1070,84 @@ pub fn choose_layout(
                 .unwrap_or_else(|| CoreError::Unsupported("no layout".into()))),
         },
     }
+}
+
+/// The predicted-quality re-split of a chord layout ([`choose_layout`]): returns the
+/// decomposition, its prediction, the cuts added and the candidates tried.
+fn resplit(
+    region: &Region,
+    opts: &DecomposeOptions,
+    size: MeshSize,
+    mut cuts: Vec<(DVec2, DVec2)>,
+    mut d: Decomposition,
+    mut p: crate::predict::Prediction,
+) -> (Decomposition, crate::predict::Prediction, usize, usize) {
+    let mut breaks = rule_breaks(&d, &p, opts);
+    // a cut must leave at least RESPLIT_CELLS cells of the requested size on its smaller side
+    let area = crate::curves::decomposition_area(&d);
+    let h2 = match size {
+        MeshSize::Cells(n) => area / n.max(1) as f64,
+        MeshSize::CellSize(h) => h * h,
+        _ => area / 20_000.0,
+    };
+    let min_area = RESPLIT_CELLS * h2;
+    let mut tried: Vec<(DVec2, DVec2)> = Vec::new();
+    let mut added = 0;
+    while tried.len() < RESPLIT_EVALS {
+        let mut order: Vec<(f64, usize)> = (0..d.blocks.len().min(p.blocks.len()))
+            .filter(|&b| p.blocks[b] < RESPLIT_BELOW)
+            .map(|b| ((1.0 - p.blocks[b]) * p.block_cells[b] as f64, b))
+            .collect();
+        order.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        let cand = order.iter().find_map(|&(_, b)| {
+            split_chord(region, &d, b, &cuts, RESPLIT_SCORE, min_area)
+                .filter(|c| !tried.contains(c))
+        });
+        let Some(c) = cand else {
+            break;
+        };
+        tried.push(c);
+        let mut next = cuts.clone();
+        next.push(c);
+        let Ok(nd) = layout_from_cuts(region, opts, &next) else {
+            continue;
+        };
+        if nd == d {
+            continue;
+        }
+        let Ok(np) = crate::predict::predict_mesh(&nd, size) else {
+            continue;
+        };
+        let nb = rule_breaks(&nd, &np, opts);
+        if std::env::var_os("UNAMALLA_LAYOUT_DEBUG").is_some() {
+            eprintln!(
+                "re-split candidate {:?}-{:?}: {} -> {} blocks, {:.2} % -> {:.2} %, breaks {breaks} -> {nb}",
+                c.0,
+                c.1,
+                d.blocks.len(),
+                nd.blocks.len(),
+                100.0 * p.good_share,
+                100.0 * np.good_share
+            );
+        }
+        if nb <= breaks && np.good_share >= p.good_share + RESPLIT_GAIN {
+            if std::env::var_os("UNAMALLA_LAYOUT_DEBUG").is_some() {
+                eprintln!(
+                    "re-split: {:?}-{:?} predicted {:.2} % -> {:.2} %",
+                    c.0,
+                    c.1,
+                    100.0 * p.good_share,
+                    100.0 * np.good_share
+                );
+            }
+            cuts = next;
+            d = nd;
+            p = np;
+            breaks = nb;
+            added += 1;
+        }
+    }
+    (d, p, added, tried.len())
 }
 
 /// Predicted and achieved μ ≥ 0.8 share of one block (report.json `block_quality`).

@@ -41,6 +41,8 @@ pub struct Prediction {
     pub good_share: f64,
     /// Predicted share per block.
     pub blocks: Vec<f64>,
+    /// Cells of each block in the coarse prediction mesh.
+    pub block_cells: Vec<usize>,
     /// Cells of the coarse prediction mesh.
     pub cells: usize,
     /// Interior nodes of the coarse mesh with valence ≠ 4 (a layout with cut joints, or one
@@ -124,15 +126,18 @@ pub fn predict_mesh(d: &Decomposition, size: MeshSize) -> Result<Prediction, Cor
     let mut good = 0.0;
     let mut total = 0usize;
     let mut blocks = Vec::with_capacity(mesh.blocks().len());
+    let mut block_cells = Vec::with_capacity(mesh.blocks().len());
     for b in 0..mesh.blocks().len() {
         let (s, c) = block_good_share(&mesh, b);
         good += s * c as f64;
         total += c;
         blocks.push(s);
+        block_cells.push(c);
     }
     Ok(Prediction {
         good_share: good / total.max(1) as f64,
         blocks,
+        block_cells,
         cells: mesh.num_quads(),
         singularities,
     })

@@ -149,39 +149,35 @@ pub fn chord_layout(
     region: &Region,
     opts: &DecomposeOptions,
 ) -> Result<Decomposition, DecomposeError> {
+    chord_layout_cuts(region, opts).map(|(_, d)| d)
+}
+
+/// [`chord_layout`] with its layout cuts: the ordered cut list (hole bridges, closing chords,
+/// transverse cuts, arm cuts) that [`layout_from_cuts`] turns into the same decomposition.
+/// A caller can append cuts to the list and rebuild (the mesher's predicted-quality
+/// re-split, `unamalla_core::pipeline::choose_layout`).
+pub fn chord_layout_cuts(
+    region: &Region,
+    opts: &DecomposeOptions,
+) -> Result<(Vec<(DVec2, DVec2)>, Decomposition), DecomposeError> {
     let per = region.perimeter();
     let spacing = opts
         .cell_size
         .unwrap_or(f64::INFINITY)
         .min(per / 1500.0)
         .max(per / 20000.0);
-    let cuts = crate::chords::layout_cuts(
+    let mut cuts = crate::chords::layout_cuts(
         region,
         spacing,
         opts.chord_aspect,
         opts.min_area_fraction * region.area(),
     )
     .map_err(|e| DecomposeError::Layout(e.0))?;
-    let tol = crate::decomposition::boundary_tol(region);
-    let mut cuts = cuts;
     // up to ARM_ROUNDS times: blocks that still keep an arm (a part ≥ ARM_SCORE chord widths
     // beyond a chord between two boundary points) get that chord as one more layout cut
     let mut d = None;
     for round in 0..=ARM_ROUNDS {
-        let mut b = Builder::new(region, opts);
-        for &(p, q) in &cuts {
-            // a cut no piece admits (rounding at a sample point) is skipped: Algorithm 1
-            // then treats that piece as it would without the layout
-            b.apply_cut(p, q, tol, Step::Chord);
-        }
-        b.protected_cuts = b.cuts.len();
-        let leaves: Vec<usize> = (0..b.nodes.len())
-            .filter(|&n| b.pieces[n].is_some())
-            .collect();
-        for n in leaves {
-            b.run_auto(n)?;
-        }
-        let dec = b.finish()?;
+        let dec = layout_from_cuts(region, opts, &cuts)?;
         let extra: Vec<(DVec2, DVec2)> = if round < ARM_ROUNDS {
             dec.blocks
                 .iter()
@@ -191,7 +187,7 @@ pub fn chord_layout(
                         .iter()
                         .map(|e| matches!(e, EdgeKind::Boundary { .. }))
                         .collect();
-                    crate::chords::arm_chord(&blk.ring, &on, ARM_SCORE)
+                    crate::chords::arm_chord(&blk.ring, &on, ARM_SCORE, 0.0)
                 })
                 .collect()
         } else {
@@ -203,7 +199,116 @@ pub fn chord_layout(
         }
         cuts.extend(extra);
     }
-    d.ok_or_else(|| DecomposeError::Layout("no decomposition".into()))
+    let mut d = d.ok_or_else(|| DecomposeError::Layout("no decomposition".into()))?;
+    // a layout cut bordering a block that Algorithm 1 could not make admissible (a sliver
+    // between a chord and the coast, too small for Algorithm 3 or 4 to cut) is withdrawn,
+    // and the piece is left to Algorithm 1 alone, while that lowers the number of such blocks
+    let tol = crate::decomposition::boundary_tol(region);
+    for _ in 0..WITHDRAW_ROUNDS {
+        let bad = inadmissible_blocks(&d, &opts.tolerances);
+        if bad.is_empty() {
+            break;
+        }
+        let on = |x: DVec2, (p, q): (DVec2, DVec2)| {
+            unamalla_mesh::geometry::point_segment_distance(x, p, q) <= tol
+        };
+        let mut drop = vec![false; cuts.len()];
+        for &b in &bad {
+            for e in &d.blocks[b].edges {
+                if let EdgeKind::Cut { cut, .. } = *e {
+                    let c = &d.cuts[cut];
+                    for (k, &lc) in cuts.iter().enumerate() {
+                        if on(c.a, lc) && on(c.b, lc) {
+                            drop[k] = true;
+                        }
+                    }
+                }
+            }
+        }
+        if !drop.iter().any(|&x| x) {
+            break;
+        }
+        let kept: Vec<(DVec2, DVec2)> = cuts
+            .iter()
+            .zip(&drop)
+            .filter(|(_, &x)| !x)
+            .map(|(&c, _)| c)
+            .collect();
+        let nd = layout_from_cuts(region, opts, &kept)?;
+        if inadmissible_blocks(&nd, &opts.tolerances).len() >= bad.len() {
+            break;
+        }
+        cuts = kept;
+        d = nd;
+    }
+    Ok((cuts, d))
+}
+
+/// Rounds of layout-cut withdrawal in [`chord_layout_cuts`].
+const WITHDRAW_ROUNDS: usize = 3;
+
+/// The blocks of `d` that are not admissible ([`Decomposition::block_admissible`]).
+fn inadmissible_blocks(d: &Decomposition, tol: &Tolerances) -> Vec<usize> {
+    (0..d.blocks.len())
+        .filter(|&b| !d.block_admissible(b, tol))
+        .collect()
+}
+
+/// The decomposition with the given **layout cuts**: each straight cut `p`–`q` (both ends on
+/// the region boundary or on an earlier cut of the list) is applied in order to the piece
+/// that admits it, the layout cuts are protected from the merge pass, and Algorithm 1
+/// finishes every piece. A cut no piece admits (an end off every piece boundary, or a cut
+/// crossing an earlier one) is skipped: Algorithm 1 then treats that piece as it would
+/// without it.
+pub fn layout_from_cuts(
+    region: &Region,
+    opts: &DecomposeOptions,
+    cuts: &[(DVec2, DVec2)],
+) -> Result<Decomposition, DecomposeError> {
+    let tol = crate::decomposition::boundary_tol(region);
+    let mut b = Builder::new(region, opts);
+    for &(p, q) in cuts {
+        b.apply_cut(p, q, tol, Step::Chord);
+    }
+    b.protected_cuts = b.cuts.len();
+    let leaves: Vec<usize> = (0..b.nodes.len())
+        .filter(|&n| b.pieces[n].is_some())
+        .collect();
+    for n in leaves {
+        b.run_auto(n)?;
+    }
+    b.finish()
+}
+
+/// A straight cut that splits block `blk` of `d` (a decomposition of `region`) across its narrowest place relative to its
+/// size: the chord with the highest `min(A₁, A₂)/w²` of at least `min_score` (module `chords`)
+/// whose ends lie on the region boundary or on one of the `layout` cuts (so that
+/// [`layout_from_cuts`] can replay it after them), meeting the boundary at no less than
+/// [`crate::chords::MIN_END_ANGLE_DEG`], and leaving at least `min_area` on its smaller side.
+/// `None` if the block has no such chord.
+pub fn split_chord(
+    region: &Region,
+    d: &Decomposition,
+    blk: usize,
+    layout: &[(DVec2, DVec2)],
+    min_score: f64,
+    min_area: f64,
+) -> Option<(DVec2, DVec2)> {
+    let tol = crate::decomposition::boundary_tol(region);
+    let b = d.blocks.get(blk)?;
+    let n = b.ring.len();
+    let on_layout = |p: DVec2| {
+        layout
+            .iter()
+            .any(|&(a, q)| unamalla_mesh::geometry::point_segment_distance(p, a, q) <= tol)
+    };
+    let on: Vec<bool> = (0..n)
+        .map(|i| match b.edges[i] {
+            EdgeKind::Boundary { .. } => true,
+            EdgeKind::Cut { .. } => on_layout(b.ring[i]) && on_layout(b.ring[(i + 1) % n]),
+        })
+        .collect();
+    crate::chords::arm_chord(&b.ring, &on, min_score, min_area)
 }
 
 /// A block part extending at least this many chord widths beyond a chord (the chord's

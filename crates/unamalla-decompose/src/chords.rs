@@ -377,11 +377,13 @@ pub fn neck_score(ring: &[DVec2]) -> f64 {
 /// The best **arm cut** of a block: the chord with the highest `min(A₁, A₂)/w²`, at least
 /// `min_score`, whose ends both lie on edges with `on_boundary[i]` (original region boundary,
 /// so the chord is a valid cut of the region), strictly inside those edges or at their
-/// vertices, and that meets the boundary at no less than [`MIN_END_ANGLE_DEG`].
+/// vertices, that meets the boundary at no less than [`MIN_END_ANGLE_DEG`], and whose smaller
+/// side has an area of at least `min_area`.
 pub(crate) fn arm_chord(
     ring: &[DVec2],
     on_boundary: &[bool],
     min_score: f64,
+    min_area: f64,
 ) -> Option<(DVec2, DVec2)> {
     let region = Region::new(ring.to_vec(), vec![]).ok()?;
     let m = ChordMesh::new(&region, region.perimeter() / 400.0).ok()?;
@@ -407,8 +409,9 @@ pub(crate) fn arm_chord(
     let mut best: Option<(f64, usize, usize)> = None;
     for (a, b, a1, _) in tree.chords(&m) {
         let w2 = m.pts[a].distance_squared(m.pts[b]);
-        let score = a1.min(tree.total - a1) / w2;
-        if score < min_score || best.is_some_and(|(s, _, _)| s >= score) {
+        let small = a1.min(tree.total - a1);
+        let score = small / w2;
+        if small < min_area || score < min_score || best.is_some_and(|(s, _, _)| s >= score) {
             continue;
         }
         if !boundary_edge(m.edge[a]) || !boundary_edge(m.edge[b]) {

@@ -207,7 +207,10 @@ mod render;
 mod repair;
 pub mod submap;
 
-pub use auto::{chord_layout, decompose, CutWeights, DecomposeOptions, Layout, ARM_SCORE};
+pub use auto::{
+    chord_layout, chord_layout_cuts, decompose, layout_from_cuts, split_chord, CutWeights,
+    DecomposeOptions, Layout, ARM_SCORE,
+};
 pub use concavity::{concavity, critical_angles, is_admissible, Concavity, Pocket, Tolerances};
 pub use corners::{select_corners, CornerWeights};
 pub use decomposition::{Block, Cut, Decomposition, EdgeKind, SideCurve, Step, TreeNode};
