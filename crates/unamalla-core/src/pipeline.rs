@@ -460,10 +460,13 @@ impl Mesher {
             preflight::COST_PER_MESH_CELL,
             limit,
         )?;
+        let allow = self.allow_non_convex;
         if self.simplify.is_none() && self.decomposition.is_none() {
             preflight::check_unsimplified(region)?;
+            if !allow {
+                preflight::check_narrow_features(region, h)?;
+            }
         }
-        let allow = self.allow_non_convex;
         let mut result = self
             .mesh_unverified(region, observer)
             .map_err(|e| preflight::explain_failure(e, region, h))?;
@@ -478,7 +481,8 @@ impl Mesher {
         }
         result.report.verification = v.clone();
         if !allow {
-            v.into_result()?;
+            v.into_result()
+                .map_err(|e| preflight::explain_guarantee(e, region, h))?;
         }
         Ok(result)
     }

@@ -16,6 +16,13 @@
 //! count: the decomposition's candidate scans are quadratic in the vertex count (measured:
 //! docs/reliability.md), so such a run would not end in reasonable time.
 //!
+//! **Narrow features without simplification.** A region meshed as given (`--no-simplify`)
+//! whose boundary folds back onto itself closer than [`MIN_GAP_FRACTION`] × the cell size over
+//! more than a cell (a 10⁻⁷-wide spike, a slit) cannot be meshed with cells of that size: the
+//! run would end in the guarantee error after the whole pipeline, at fine sizes after minutes
+//! in the smoother. [`check_narrow_features`] refuses it before the work, naming the vertex
+//! and the width ([`narrow_feature`]); the default simplification removes such features.
+//!
 //! **Gaps between rings.** A hole closer to the outer ring (or to another hole) than the
 //! merge tolerance of block nodes cannot be meshed at all, and one much closer than a cell
 //! cannot be meshed with cells of that size: the stages then fail with internal messages
@@ -93,6 +100,32 @@ pub enum PreflightError {
         vertices: usize,
         /// [`MAX_UNSIMPLIFIED_VERTICES`].
         max: usize,
+    },
+    /// Without simplification: a part of the boundary folds back on itself closer than the
+    /// meshable gap (a spike or slit narrower than [`MIN_GAP_FRACTION`] × the cell size, longer
+    /// than a cell).
+    #[error(
+        "{}, vertex {vertex} ({:.6e}, {:.6e}), is {width:.3e} from the same ring {sep:.3e} further \
+         along it: a spike or slit narrower than the meshable gap of {need:.3e} ({MIN_GAP_FRACTION} × the \
+         cell size {h:.3e}) cannot be meshed without simplification; drop --no-simplify (the \
+         simplification removes it) or use --cell-size ≤ {:.3e}",
+        ring_name(*ring), at[0], at[1], width / MIN_GAP_FRACTION
+    )]
+    NarrowFeature {
+        /// The ring (0 = outer, k ≥ 1 = hole k − 1).
+        ring: usize,
+        /// The vertex of that ring.
+        vertex: usize,
+        /// Its coordinates.
+        at: [f64; 2],
+        /// Its distance from the other side of the feature.
+        width: f64,
+        /// The distance along the ring between the two sides.
+        sep: f64,
+        /// The cell size.
+        h: f64,
+        /// `MIN_GAP_FRACTION · h`.
+        need: f64,
     },
     /// A failure explained by a too-narrow gap between rings.
     #[error(
@@ -202,6 +235,93 @@ pub fn check_unsimplified(region: &Region) -> Result<(), PreflightError> {
     }
 }
 
+/// The narrowest fold of one ring onto itself, as `(ring, vertex, width, separation)`: the
+/// vertex of `region` closest to an edge of its own ring among the pairs that are closer than
+/// `gap` in the plane but more than `h` apart along the ring (cyclic arc length), or `None`.
+///
+/// Two boundary points within `gap` of each other whose connecting arc is longer than `h`
+/// bound a feature (spike, slit, neck) narrower than `gap` over more than a cell: no cell of
+/// size `h` fits in it. A smooth, densely sampled boundary has no such pair (points close in
+/// the plane are close along the ring), and a corner only if it is sharper than
+/// `2·asin(gap / h)` (about 1.15° for `gap = 0.01·h`). Each vertex queries the ring's segment
+/// index with a box of half-width `gap`, so the work is `O(n log n)` for `gap` below the
+/// vertex spacing.
+pub fn narrow_feature(region: &Region, gap: f64, h: f64) -> Option<(usize, usize, f64, f64)> {
+    if !(gap > 0.0 && h > 0.0) {
+        return None;
+    }
+    let rings: Vec<Vec<DVec2>> = region.rings().map(|r| r.points().to_vec()).collect();
+    let cum: Vec<Vec<f64>> = rings
+        .iter()
+        .map(|ring| {
+            let n = ring.len();
+            let mut c = Vec::with_capacity(n + 1);
+            c.push(0.0);
+            for k in 0..n {
+                c.push(c[k] + (ring[(k + 1) % n] - ring[k]).length());
+            }
+            c
+        })
+        .collect();
+    let index = SegmentIndex::new(rings.clone());
+    let mut best: Option<(usize, usize, f64, f64)> = None;
+    let d = DVec2::splat(gap);
+    for (r, ring) in rings.iter().enumerate() {
+        let total = cum[r][ring.len()];
+        for (k, &p) in ring.iter().enumerate() {
+            for e in index.candidates(p - d, p + d) {
+                if e.ring != r {
+                    continue;
+                }
+                let (a, b) = index.edge(e);
+                let dist = point_segment_distance(p, a, b);
+                if dist >= gap || best.is_some_and(|x| dist >= x.2) {
+                    continue;
+                }
+                let ab = b - a;
+                let t = if ab.length_squared() > 0.0 {
+                    ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let sq = cum[r][e.edge] + t * (cum[r][e.edge + 1] - cum[r][e.edge]);
+                let diff = (sq - cum[r][k]).abs();
+                let sep = diff.min(total - diff);
+                if sep > h {
+                    best = Some((r, k, dist, sep));
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Refuses to mesh `region` as given (without simplification) at cell size `h` when it has a
+/// [`narrow_feature`] below [`MIN_GAP_FRACTION`] × `h`: such a run cannot meet the guarantee
+/// and, at fine sizes, spent minutes failing in the smoother (issue #24, the 10⁻⁷-wide spike:
+/// 681 s to exit 3 at the default size).
+pub fn check_narrow_features(region: &Region, h: f64) -> Result<(), PreflightError> {
+    let need = MIN_GAP_FRACTION * h;
+    match narrow_feature(region, need, h) {
+        Some((ring, vertex, width, sep)) => {
+            let p = region
+                .rings()
+                .nth(ring)
+                .map_or(DVec2::NAN, |r| r.points()[vertex]);
+            Err(PreflightError::NarrowFeature {
+                ring,
+                vertex,
+                at: [p.x, p.y],
+                width,
+                sep,
+                h,
+                need,
+            })
+        }
+        None => Ok(()),
+    }
+}
+
 /// The closest pair of distinct rings `(a, b, distance)` (rings numbered as in
 /// [`PreflightError::NarrowGap`]), or `None` without holes. Uses the region's segment index:
 /// for every vertex, the edges of other rings within the current best distance.
@@ -263,6 +383,26 @@ pub fn explain_failure(e: CoreError, region: &Region, h: f64) -> CoreError {
     }
 }
 
+/// The guarantee error `e` of a finished mesh, explained like [`explain_failure`]: when
+/// `region` has two rings closer than [`MIN_GAP_FRACTION`] × `h` the cause is that gap (an
+/// input the size cannot mesh, [`PreflightError::NarrowGap`] with the verification's failures
+/// as the detail), not the cells it produced there; otherwise `e` unchanged.
+pub fn explain_guarantee(e: crate::verify::GuaranteeNotMet, region: &Region, h: f64) -> CoreError {
+    match ring_gaps(region) {
+        Some((a, b, gap)) if h > 0.0 && gap < MIN_GAP_FRACTION * h => {
+            CoreError::Preflight(PreflightError::NarrowGap {
+                a,
+                b,
+                gap,
+                h,
+                need: MIN_GAP_FRACTION * h,
+                detail: e.0.to_string(),
+            })
+        }
+        _ => CoreError::Guarantee(e),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,6 +451,69 @@ mod tests {
         assert_eq!(parse_bytes(""), None);
         assert_eq!(human(1536.0), "1.5 KiB");
         assert_eq!(human((4u64 << 30) as f64), "4.0 GiB");
+    }
+
+    #[test]
+    fn a_spike_and_a_slit_are_narrow_features_a_circle_and_a_square_are_not() {
+        // the hostile fixture's spike: sides through (5 ± 1e-7, 10) and the tip (5, 13). The
+        // base vertex (5 + 1e-7, 10) is 2·10⁻⁷ from the other side's end point (5 − 1e-7, 10)
+        // (and from the side itself: 2e-7 · 3 / √(9 + 10⁻¹⁴)), 3 + 3 = 6 further along the ring
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        let spike = Region::new(
+            vec![
+                p(0.0, 0.0),
+                p(10.0, 0.0),
+                p(10.0, 10.0),
+                p(5.0 + 1e-7, 10.0),
+                p(5.0, 13.0),
+                p(5.0 - 1e-7, 10.0),
+                p(0.0, 10.0),
+            ],
+            vec![],
+        )
+        .unwrap();
+        let h = 0.58;
+        let (ring, _, width, sep) = narrow_feature(&spike, MIN_GAP_FRACTION * h, h).unwrap();
+        assert_eq!(ring, 0);
+        assert!((width - 2e-7).abs() < 1e-12, "{width}");
+        assert!((sep - 6.0).abs() < 1e-6, "{sep}");
+        let e = check_narrow_features(&spike, h).unwrap_err();
+        assert!(e.to_string().contains("drop --no-simplify"), "{e}");
+        // a slit 10⁻³ wide and 6 deep: its walls are 10⁻³ apart, 12 + 10⁻³ along the ring
+        let slit = Region::new(
+            vec![
+                p(0.0, 0.0),
+                p(10.0, 0.0),
+                p(10.0, 10.0),
+                p(5.0005, 10.0),
+                p(5.0005, 4.0),
+                p(4.9995, 4.0),
+                p(4.9995, 10.0),
+                p(0.0, 10.0),
+            ],
+            vec![],
+        )
+        .unwrap();
+        let (_, _, width, sep) = narrow_feature(&slit, MIN_GAP_FRACTION * h, h).unwrap();
+        assert!((width - 1e-3).abs() < 1e-12, "{width}");
+        assert!(sep > 6.0, "{sep}");
+        // at a cell size with 0.01·h below the slit's width it is meshable
+        assert!(check_narrow_features(&slit, 0.05).is_ok());
+        // a circle of 10,000 vertices (spacing 6.3e-4 < 0.01·h) and a square: nothing
+        let circle: Vec<DVec2> = (0..10_000)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / 10_000.0;
+                p(t.cos(), t.sin())
+            })
+            .collect();
+        let circle = Region::new(circle, vec![]).unwrap();
+        assert!(narrow_feature(&circle, 0.001, 0.1).is_none());
+        let square = Region::new(
+            vec![p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)],
+            vec![],
+        )
+        .unwrap();
+        assert!(check_narrow_features(&square, 0.1).is_ok());
     }
 
     #[test]
