@@ -17,7 +17,8 @@ use unamalla_core::optim::{NullObserver, Observer, ProgressObserver};
 /// Arguments of `unamalla hex`.
 #[derive(clap::Args, Debug)]
 pub struct HexArgs {
-    /// A built-in region (sphere, ellipsoid, box, pico, cosin, shell, parabs) or a directory
+    /// A built-in region (sphere, ellipsoid, box, pico, cosin, shell, parabs, elipsoideg,
+    /// yacimiento, sydney) or a directory
     /// holding the six face grids i_min.txt … k_max.txt (built-in names take precedence:
     /// write `./sphere` for a directory called `sphere`).
     pub case: String,

@@ -183,6 +183,46 @@ fn interval_assignment_adds_on_the_longer_edge() {
     assert_eq!(f1.intervals, vec![1, 2, 1, 3, 1]);
 }
 
+/// Example 2 of Ruiz-Gironés & Sarrate (2010, Fig. 14) compares the objectives f₁ = Σ n_e/l(e)
+/// and f₂ = f₁ + max n_e/N_e without numbers; here a loop where they disagree, solved by hand:
+/// bottom +i of length 4 (N = 4), right +j and left −j of length 1 (N = 1), top two −i edges
+/// of lengths 1 and 2 with N = 1 each (the second prescribed). Closure: n₃ + n₄ = n₁ ≥ 4 and
+/// n₂ = n₅. With n₁ = 4 the top splits are (1, 3), (2, 2), (3, 1):
+/// f₁ = 1 + 1 + n₃ + n₄/2 + 1 = 5.5, 6, 6.5 → (1, 3), the long edge takes the elements;
+/// f₂ = f₁ + max(1, n₃, n₄) = 8.5, 8, 9.5 → (2, 2), the elements spread (the paper's "f₂
+/// spreads the elements along the boundary"); a larger n₁ only adds cost.
+#[test]
+fn interval_objectives_f1_and_f2_disagree() {
+    let mut e4 = edge(4, 2.0, Direction::MinusI);
+    e4.min_intervals = Some(1);
+    let problem = IntervalProblem {
+        edges: vec![
+            edge(1, 4.0, Direction::PlusI),
+            edge(2, 1.0, Direction::PlusJ),
+            edge(3, 1.0, Direction::MinusI),
+            e4,
+            edge(5, 1.0, Direction::MinusJ),
+        ],
+        twins: vec![],
+    };
+    let f2 = assign_intervals(&problem, &IntervalOptions::new(1.0)).unwrap();
+    assert_eq!(f2.intervals, vec![4, 1, 2, 2, 1]);
+    assert!((f2.max_ratio - 2.0).abs() < 1e-12);
+    assert!((f2.objective - 8.0).abs() < 1e-9, "{}", f2.objective);
+    let f1 = assign_intervals(
+        &problem,
+        &IntervalOptions {
+            include_max_term: false,
+            ..IntervalOptions::new(1.0)
+        },
+    )
+    .unwrap();
+    assert_eq!(f1.intervals, vec![4, 1, 1, 3, 1]);
+    assert!((f1.objective - 5.5).abs() < 1e-9, "{}", f1.objective);
+    assert!((f1.max_ratio - 3.0).abs() < 1e-12);
+    assert!(f1.verification.passed() && f2.verification.passed());
+}
+
 #[test]
 fn interval_assignment_twins_and_infeasibility() {
     // Two virtual-edge copies must be equal: +j copy (N = 2) and −j copy (N = 5 from a prescription).

@@ -8,6 +8,7 @@
 //! cargo run --release -p unamalla-core --example hex_study -- hessian [cells] [runs]
 //! cargo run --release -p unamalla-core --example hex_study -- b-study <case> <mu0> <mu_min> <iters> [m,n,p]
 //! cargo run --release -p unamalla-core --example hex_study -- b-trace <case> <m,n,p|-> <mu0> <factor> <iters> <bj|mg|jacobi|none> <cg_max> [mu_min]
+//! cargo run --release -p unamalla-core --example hex_study -- energy [case ...]
 //! ```
 //!
 //! * `a-time`: best-of-`runs` wall time of Algorithm A alone (the `run_hex` driver with the
@@ -23,6 +24,13 @@
 //!   μ factor, iterations per step, CG preconditioner and CG iteration cap; prints per μ step
 //!   the solver iterations, inner CG iterations, evaluations, stop reason, wall/CPU seconds
 //!   and the non-hexahedral count (where B's time goes).
+//! * `energy`: the thesis's energy values (Cortés Aguirre 2012 §3.4.2–§3.4.3): per case,
+//!   `H_ω` of the perturbed start at the thesis's absolute `ω = 200` (parametric and index
+//!   scaling; the thesis's sphere starts at `f = 0.0261538`), then Algorithm A (defaults) and
+//!   the final mesh's [`energy_variants`](unamalla_core::functionals::energy_variants)
+//!   (the thesis's sphere ends at `f = 2.26543`); for the sphere also the same with a
+//!   different cube → ball map (Nowell's, see `nowell_ball`) to show how much the radial map
+//!   itself moves the optimum.
 //! * `hessian`: one Hessian refresh of `H_ω` on a folded `cells³` grid, node-block against
 //!   the reference assembly (best of `runs`).
 
@@ -507,6 +515,109 @@ fn b_trace(case: HexCase, dims: Option<(usize, usize, usize)>, o: &BTrace) {
     );
 }
 
+/// Nowell's cube → ball map `x·√(1 − y²/2 − z²/2 + y²z²/3)` (and cyclic), a smooth
+/// alternative to the radial map with a different boundary node distribution.
+fn nowell_ball(q: unamalla_core::mesh::DVec3) -> unamalla_core::mesh::DVec3 {
+    let (x2, y2, z2) = (q.x * q.x, q.y * q.y, q.z * q.z);
+    unamalla_core::mesh::DVec3::new(
+        q.x * (1.0 - y2 / 2.0 - z2 / 2.0 + y2 * z2 / 3.0).sqrt(),
+        q.y * (1.0 - z2 / 2.0 - x2 / 2.0 + x2 * z2 / 3.0).sqrt(),
+        q.z * (1.0 - x2 / 2.0 - y2 / 2.0 + x2 * y2 / 3.0).sqrt(),
+    )
+}
+
+fn energy(name: &str) {
+    use unamalla_core::functionals::energy_variants;
+    use unamalla_core::mesh::{HasHexCells, StructuredGrid3};
+    let (case, nowell) = match name {
+        "sphere-nowell" => (HexCase::Sphere, true),
+        n => (n.parse::<HexCase>().expect("case"), false),
+    };
+    let dims = case.default_size();
+    let mut g = if nowell {
+        let t = |i: usize, k: usize| -1.0 + 2.0 * i as f64 / (k - 1) as f64;
+        StructuredGrid3::from_fn(dims.0, dims.1, dims.2, |i, j, k| {
+            nowell_ball(unamalla_core::mesh::DVec3::new(
+                t(i, dims.0),
+                t(j, dims.1),
+                t(k, dims.2),
+            ))
+        })
+        .expect("grid")
+    } else {
+        case.initial_grid(dims).expect("grid")
+    };
+    let cells = |g: &StructuredGrid3| -> Vec<[unamalla_core::mesh::DVec3; 8]> {
+        (0..g.num_hexes()).map(|c| g.hex_points(c)).collect()
+    };
+    let par = Scaling3::Parametric {
+        m: dims.0,
+        n: dims.1,
+        p: dims.2,
+    };
+    let e0 = energy_variants(&cells(&g), par).expect("energy");
+    let (amp, nc0) = case
+        .default_perturbation(dims)
+        .apply(&mut g, 1)
+        .unwrap_or((0.0, 0));
+    let topo = Arc::new(HexTopology::from_mesh(&g).expect("topology"));
+    let x0 = topo.initial_x();
+    let h200 = |s: Scaling3| {
+        HexFunctional::h_omega(topo.clone(), 200.0, s)
+            .expect("H")
+            .value(&x0)
+    };
+    println!(
+        "{name} {}x{}x{}: unperturbed E (printed) {:.5}; perturbed (amp {amp:.3}, {nc0} non-convex): H_200 parametric {:.7}, index {:.3e}",
+        dims.0, dims.1, dims.2, e0.printed, h200(par), h200(Scaling3::Index)
+    );
+    let opts = HexRunOptions {
+        algorithm: HexAlgorithm::A,
+        ..HexRunOptions::default()
+    };
+    let r = run_hex(&mut g, &opts, &mut NullObserver).expect("run");
+    let a = r.algorithm_a.expect("A ran");
+    let e = energy_variants(&cells(&g), par).expect("energy");
+    let show = |what: &str,
+                it: usize,
+                f: f64,
+                omega: f64,
+                e: &unamalla_core::functionals::EnergyVariants| {
+        println!(
+            "  {what} ({it} it): f {f:.5} at ω {omega:.3e}; E printed {:.5}, per-decomposition {:.5}, volume-weighted {:.5}, interior-raw {:.5} (V ≤ 0: {})",
+            e.printed, e.per_decomposition, e.volume_weighted, e.interior_raw, e.non_positive
+        )
+    };
+    show(
+        &format!("after A (NC {})", r.non_convex_cells),
+        a.iterations,
+        a.f,
+        a.omega.unwrap_or(f64::NAN),
+        &e,
+    );
+    // the thesis's sphere run continues the ω halving to ω* = 10⁻⁸ (§3.4.3), where H_ω is the
+    // energy itself: minimise H at ω = 10⁻⁸·v̄ from the convex A mesh (convexity safeguard on)
+    let topo = Arc::new(HexTopology::from_mesh(&g).expect("topology"));
+    let mut x = topo.initial_x();
+    let probe = HexFunctional::h_omega(topo.clone(), 1.0, par).expect("probe");
+    let mut obs = NullObserver;
+    let mut session = Session::new(&probe, &x, &mut obs);
+    let vbar = session.convexity(&probe, &x).mean;
+    session.set_phase(Phase::Classic);
+    session.guard_threshold = opts.omega.eps * vbar;
+    let w = 1e-8 * vbar;
+    let hf = HexFunctional::h_omega(topo.clone(), w, par).expect("H");
+    let solver = SolverOptions {
+        max_iter: 500,
+        ..opts.omega.solver.clone()
+    };
+    let rr = minimize_with(&hf, &mut x, &solver, &mut session, None).expect("minimize");
+    let mut g2 = g.clone();
+    topo.scatter(&x, unamalla_core::mesh::HasNodes::nodes_mut(&mut g2));
+    let e2 = energy_variants(&cells(&g2), par).expect("energy");
+    show("then H at ω = 1e-8·v̄", rr.iterations, rr.f, w, &e2);
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mode = args.first().map(String::as_str).unwrap_or("a-time");
@@ -563,8 +674,20 @@ fn main() {
             };
             b_trace(case(), dims, &o);
         }
+        "energy" => {
+            let cases: Vec<String> = if args.len() > 1 {
+                args[1..].to_vec()
+            } else {
+                vec!["sphere".into(), "ellipsoid".into(), "pico".into()]
+            };
+            for c in cases {
+                energy(&c);
+            }
+        }
         other => {
-            eprintln!("unknown mode {other}: a-time | a-variants | hessian | b-study | b-trace")
+            eprintln!(
+                "unknown mode {other}: a-time | a-variants | hessian | b-study | b-trace | energy"
+            )
         }
     }
 }

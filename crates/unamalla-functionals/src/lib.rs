@@ -87,8 +87,8 @@ pub use csr::Csr;
 pub use error::FunctionalError;
 pub use eval::{evaluate, EvalReport, FunctionalSpec, FUNCTIONAL_NAMES};
 pub use hex::{
-    face_coplanarity_cos, face_planarity_max_cos, hex_tets, HexFunctional, HexTopology, Scaling3,
-    Tet, HEX_QUAD_FACES,
+    energy_variants, face_coplanarity_cos, face_planarity_max_cos, hex_tets, EnergyVariants,
+    HexFunctional, HexTopology, Scaling3, Tet, HEX_QUAD_FACES,
 };
 pub use kernels2::{
     inv_k, phi_omega, phi_regularized, recommended_alpha_hat, s_function, Area, AreaOrthogonality,

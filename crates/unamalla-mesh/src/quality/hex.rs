@@ -131,6 +131,43 @@ pub fn face_cosine(v: [DVec3; 4]) -> f64 {
     worst
 }
 
+/// Criterion 1 of face planarity (Cortés Aguirre 2012, §4.1 eq. (4.1); the criterion Table 4.1
+/// rejects): the volume `|V_l|` of the tetrahedron on the four vertices of the face `ABCD`,
+/// `|det(B − A, D − A, C − A)|/6`. 0 for a planar face. Unlike [`face_cosine`] (criterion 2,
+/// eq. (4.2)) it scales with the cube of the mesh size, so one tolerance (the thesis's
+/// `ε_v = 10⁻⁶`) means different things on different regions (Table 4.1: Yacimiento 2, with
+/// coordinates of order 10⁴, has max `|V_l|` ≈ 5·10⁴ while its max `|cos|` is below 10⁻²).
+pub fn face_volume(v: [DVec3; 4]) -> f64 {
+    tet_det(v[0], v[1], v[3], v[2]).abs() / 6.0
+}
+
+/// The smallest height and the smallest face area of the tetrahedron on the four vertices of
+/// a face (App. B.6 of Cortés Aguirre 2012: "minimum heights and areas of the tetrahedra formed
+/// on each cell face"; small heights mean a nearly planar face, tight areas a regular one).
+/// The height of vertex `i` is `3·vol / area(opposite triangle)`; a degenerate opposite
+/// triangle (area below `DBL_MIN`) gives height 0. Returns `(min height, min area)`.
+pub fn face_height_area(v: [DVec3; 4]) -> (f64, f64) {
+    let vol = face_volume(v);
+    let mut hmin = f64::INFINITY;
+    let mut amin = f64::INFINITY;
+    for i in 0..4 {
+        let [a, b, c] = [(i + 1) % 4, (i + 2) % 4, (i + 3) % 4].map(|k| v[k]);
+        let area = 0.5 * (b - a).cross(c - a).length();
+        amin = amin.min(area);
+        hmin = hmin.min(if area < DBL_MIN {
+            0.0
+        } else {
+            3.0 * vol / area
+        });
+    }
+    (hmin, amin)
+}
+
+/// [`face_volume`] of the six [`PLANARITY_FACES`] of a hex.
+pub fn face_volumes(h: &[DVec3; 8]) -> [f64; 6] {
+    PLANARITY_FACES.map(|f| face_volume([h[f[0]], h[f[1]], h[f[2]], h[f[3]]]))
+}
+
 /// [`face_cosine`] of the six [`PLANARITY_FACES`] of a hex.
 pub fn face_planarity(h: &[DVec3; 8]) -> [f64; 6] {
     PLANARITY_FACES.map(|f| face_cosine([h[f[0]], h[f[1]], h[f[2]], h[f[3]]]))
@@ -351,6 +388,8 @@ pub struct HexMetrics {
     pub tet_dets: [f64; 10],
     /// Face planarity `|cos θ|` of the six [`PLANARITY_FACES`].
     pub face_cos: [f64; 6],
+    /// Face planarity by volume (criterion 1, [`face_volume`]) of the six faces.
+    pub face_vol: [f64; 6],
 }
 
 impl HexMetrics {
@@ -366,6 +405,7 @@ impl HexMetrics {
             oddy: oddy(h),
             tet_dets: hex_tet_dets(h),
             face_cos: face_planarity(h),
+            face_vol: face_volumes(h),
         }
     }
 
@@ -389,6 +429,36 @@ impl HexMetrics {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    /// Criterion 1 and the App. B.6 face measures by hand: the unit square with vertex C
+    /// lifted by δ.
+    #[test]
+    fn face_volume_height_area_by_hand() {
+        let d = 0.1;
+        let f = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, d),
+            DVec3::new(0.0, 1.0, 0.0),
+        ];
+        // det(B−A, D−A, C−A) = det(e1, e2, (1, 1, δ)) = δ, volume δ/6
+        assert_relative_eq!(face_volume(f), d / 6.0, epsilon = 1e-15);
+        // triangle areas: DAB = 1/2; ABC = CDA = √(1 + δ²)/2;
+        // BCD = |(C − B) × (D − B)|/2 = |(0, 1, δ) × (−1, 1, 0)|/2 = |(−δ, −δ, 1)|/2
+        let bcd = (1.0 + 2.0 * d * d).sqrt() / 2.0;
+        let (h, a) = face_height_area(f);
+        assert_relative_eq!(a, 0.5, epsilon = 1e-15);
+        // heights 3V/area: C over ABD = δ; A over BCD = (δ/2)/bcd, the smallest
+        assert_relative_eq!(h, (d / 2.0) / bcd, epsilon = 1e-15);
+        assert!(h < d);
+        // a planar face: volume and min height 0, scale: volume ∝ s³
+        let flat = [f[0], f[1], DVec3::new(1.0, 1.0, 0.0), f[3]];
+        assert_eq!(face_volume(flat), 0.0);
+        assert_eq!(face_height_area(flat).0, 0.0);
+        let big = f.map(|p| p * 10.0);
+        assert_relative_eq!(face_volume(big), 1000.0 * d / 6.0, epsilon = 1e-12);
+        assert_relative_eq!(face_cosine(big), face_cosine(f), epsilon = 1e-15);
+    }
 
     fn unit_cube() -> [DVec3; 8] {
         [

@@ -65,8 +65,9 @@ pub mod quad;
 pub mod report;
 
 pub use hex::{
-    face_planarity, hex_is_convex_10tet, hex_tet_dets, hex_tet_jacobians, hex_tet_volumes,
-    max_face_cosine, HexMetrics, HEX_TETS, HEX_TET_INTERIOR, PLANARITY_FACES,
+    face_height_area, face_planarity, face_volume, face_volumes, hex_is_convex_10tet, hex_tet_dets,
+    hex_tet_jacobians, hex_tet_volumes, max_face_cosine, HexMetrics, HEX_TETS, HEX_TET_INTERIOR,
+    PLANARITY_FACES,
 };
 pub use mesh::{
     alpha_stats, hex_cell_metrics, hex_metrics_per_cell, hex_non_convex_count,
