@@ -16,6 +16,10 @@
 //!   `+∞` at non-convex points: without it L-BFGS folds the mesh, see `tests/argmin.rs` of
 //!   unamalla-optim), stopped by argmin's `target_cost`.
 //!
+//! Before each solver's criterion samples, one probe run (outside criterion's samples) prints its
+//! iterations, the remaining gap, convexity and its wall time on stderr. The sizes can be
+//! restricted with `UNAMALLA_BENCH_SIZES`, e.g. `UNAMALLA_BENCH_SIZES=100` (default `100,300`).
+//!
 //! `cargo bench -p unamalla-workspace --bench argmin_comparison [-- FILTER]`
 
 use std::sync::Arc;
@@ -144,22 +148,30 @@ const THEIRS: [&str; 3] = ["argmin-lbfgs", "argmin-newton-cg", "argmin-trust-reg
 fn bench(cr: &mut Criterion) {
     let mut group = cr.benchmark_group("winslow_sinusoidal");
     group.sample_size(10);
-    for n in [100usize, 300] {
+    let sizes: Vec<usize> = std::env::var("UNAMALLA_BENCH_SIZES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|t| t.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![100, 300]);
+    for n in sizes {
         let c = case(n);
-        let report = |name: &str, (it, f, convex): (usize, f64, bool)| {
+        let report = |name: &str, run: &dyn Fn() -> (usize, f64, bool)| {
+            let t = std::time::Instant::now();
+            let (it, f, convex) = run();
             eprintln!(
-                "{name}/{n}: {it} iterations, (F − F*)/(F₀ − F*) = {:.2e}, convex {convex}",
-                (f - c.f_star) / (c.f.value(&c.x0) - c.f_star)
+                "{name}/{n}: {it} iterations, (F − F*)/(F₀ − F*) = {:.2e}, convex {convex}, \
+                 probe run {:.3} s",
+                (f - c.f_star) / (c.f.value(&c.x0) - c.f_star),
+                t.elapsed().as_secs_f64()
             );
         };
         for s in OURS {
-            report(s.name(), ours(&c, s));
+            report(s.name(), &|| ours(&c, s));
             group.bench_with_input(BenchmarkId::new(s.name(), n), &n, |b, _| {
                 b.iter(|| ours(&c, s))
             });
         }
         for name in THEIRS {
-            report(name, theirs(&c, name));
+            report(name, &|| theirs(&c, name));
             group.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
                 b.iter(|| theirs(&c, name))
             });
