@@ -1,7 +1,7 @@
 //! Every [`Problem`] as an [argmin](https://argmin-rs.org) problem (feature `argmin`, on by
 //! default).
 //!
-//! [`ArgminProblem`] implements argmin's [`CostFunction`], [`Gradient`] and [`Hessian`] for any
+//! [`ArgminProblem`] implements argmin's [`CostFunction`](argmin::core::CostFunction), [`Gradient`](argmin::core::Gradient) and [`Hessian`](argmin::core::Hessian) for any
 //! functional of `unamalla-functionals` (quad and hex functionals alike, and any user type that
 //! implements [`Problem`]): the parameter vector is the problem's variable vector `Vec<f64>`
 //! (free-node coordinates interleaved, see [`Problem`]) and the Hessian is a
@@ -125,7 +125,7 @@ impl<'a, P: Problem + ?Sized> ArgminProblem<'a, P> {
         }
     }
 
-    /// The problem with the convexity guard: [`CostFunction::cost`] is `+∞` wherever the
+    /// The problem with the convexity guard: [`CostFunction::cost`](argmin::core::CostFunction::cost) is `+∞` wherever the
     /// smallest measure over the elements with a free vertex is `≤ threshold` (0 for convex,
     /// `ε·ᾱ` for ε-convex). The elements with a free vertex are found at `x0` as the solvers'
     /// [`Session`] finds them (by perturbing the free variables).
