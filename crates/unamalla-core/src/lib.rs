@@ -47,6 +47,9 @@ pub mod single_block;
 pub mod untangle;
 pub mod verify;
 
+/// The `glam` release whose `DVec2`/`DVec3` are the points of the whole API (re-exported so users
+/// get the matching types without naming a version of their own).
+pub use glam;
 pub use unamalla_bspline as bspline;
 pub use unamalla_compat_ilp as compat_ilp;
 pub use unamalla_contour as contour;

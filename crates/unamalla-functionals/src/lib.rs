@@ -80,6 +80,8 @@ pub mod error;
 pub mod eval;
 pub mod hex;
 pub mod kernels2;
+#[cfg(feature = "nalgebra-sparse")]
+pub mod nalgebra_sparse_conv;
 pub mod problem;
 pub mod quad;
 
@@ -97,5 +99,7 @@ pub use kernels2::{
     RegularizedSmoothness, SArgument, SOmegaEps, Scaled, Smoothness, SpacingWeights, Sum, Terms,
     TriKernel, TriScalars, WeightedLength, A4P,
 };
+#[cfg(feature = "nalgebra-sparse")]
+pub use nalgebra_sparse_conv::CsrConversionError;
 pub use problem::{LocalModel, Problem};
 pub use quad::{AlphaSummary, QuadFunctional, QuadTopology};

@@ -30,10 +30,12 @@
 //! **Why not `argmin`.** The solvers are written here, not taken from `argmin` 0.11, for
 //! correctness reasons: every trial point must pass the convexity safeguard below (argmin's
 //! line searches and trust regions have no hook to reject a point short of returning `+∞`,
-//! which its Moré–Thuente does not handle), its `NewtonCG` has no preconditioner and its
-//! `MoreThuente` can panic with "not a descent direction" (reference notes §5), and the
-//! MINPACK-2 failure codes are needed verbatim for the UNAMALLA messages. No timing comparison
-//! with `argmin` was made.
+//! which its Moré–Thuente answers with an error, "NaN or Inf encountered", instead of a shorter
+//! step), its `NewtonCG` has no preconditioner, and the MINPACK-2 failure codes are needed
+//! verbatim for the UNAMALLA messages. (argmin 0.11 returns errors where older releases
+//! panicked, e.g. "Search direction must be a descent direction".) With feature `argmin`
+//! (default) every [`Problem`](unamalla_functionals::Problem) is an argmin problem
+//! ([`argmin_adapter`]); the timing comparison is in docs/benchmarks.md.
 //!
 //! ## Safeguard (the convexity contract)
 //! A [`Session`](monitor::Session) finds the elements with at least one free vertex (by
@@ -97,6 +99,8 @@
 #![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
+#[cfg(feature = "argmin")]
+pub mod argmin_adapter;
 pub mod coarse_to_fine;
 pub mod drivers;
 pub mod error;
