@@ -887,6 +887,10 @@ pub const LAYOUT_ASPECTS: [(&str, f64); 3] = [
 /// Predicted-quality re-split: at most this many candidate cuts are tried
 /// ([`choose_layout`]).
 pub const RESPLIT_EVALS: usize = 8;
+/// Layouts with more blocks than this are not re-split: every candidate rebuilds and predicts
+/// the whole layout (work linear in the blocks), so the re-split's work is bounded by
+/// `RESPLIT_EVALS` rebuilds of a layout of at most this size.
+pub const RESPLIT_MAX_BLOCKS: usize = 150;
 /// A block is a re-split candidate while its predicted μ ≥ 0.8 share is below this.
 pub const RESPLIT_BELOW: f64 = 0.9;
 /// Smallest chord score `min(A₁, A₂)/w²` of a re-split cut: the smaller part extends at
@@ -962,7 +966,8 @@ fn rule_breaks(
 /// ([`unamalla_decompose::split_chord`]) gets it as one more layout cut; the layout is rebuilt
 /// ([`unamalla_decompose::layout_from_cuts`]) and predicted again, and the cut is kept when the
 /// predicted share rises by at least [`RESPLIT_GAIN`] without more rule breaks. At most
-/// [`RESPLIT_EVALS`] candidates are tried, so the work is bounded.
+/// [`RESPLIT_EVALS`] candidates are tried, on layouts of at most [`RESPLIT_MAX_BLOCKS`]
+/// blocks, so the work is bounded.
 pub fn choose_layout(
     region: &Region,
     opts: &DecomposeOptions,
@@ -1097,7 +1102,7 @@ fn resplit(
     let min_area = RESPLIT_CELLS * h2;
     let mut tried: Vec<(DVec2, DVec2)> = Vec::new();
     let mut added = 0;
-    while tried.len() < RESPLIT_EVALS {
+    while tried.len() < RESPLIT_EVALS && d.blocks.len() <= RESPLIT_MAX_BLOCKS {
         let mut order: Vec<(f64, usize)> = (0..d.blocks.len().min(p.blocks.len()))
             .filter(|&b| p.blocks[b] < RESPLIT_BELOW)
             .map(|b| ((1.0 - p.blocks[b]) * p.block_cells[b] as f64, b))
