@@ -22,6 +22,9 @@
 //!   (6.8) σ = 0.1 with the default stop rules;
 //! * `sigma05` — the same with a first stage at σ = 0.5.
 //!
+//! With `UNAMALLA_STUDY_PNG=DIR` every run also writes its μ band picture
+//! (`unamalla_core::render::quality_png`, 800 px) to `DIR/REGION-CANDIDATE.png`.
+//!
 //! All candidates but `default` and `c2f*` run without coarse levels. The progress line of the
 //! coarse levels (cells and iterations per level) is printed under the table row.
 
@@ -130,6 +133,14 @@ fn main() {
                         .iter()
                         .find(|(s, _)| *s == Stage::Smooth)
                         .map_or(f64::NAN, |(_, t)| *t);
+                    if let Ok(dir) = std::env::var("UNAMALLA_STUDY_PNG") {
+                        let png = unamalla_core::render::quality_png(&r.mesh, None, 800);
+                        match png.map(|b| std::fs::write(format!("{dir}/{name}-{cand}.png"), b)) {
+                            Ok(Ok(())) => {}
+                            Ok(Err(e)) => eprintln!("{name} {cand}: png not written: {e}"),
+                            Err(e) => eprintln!("{name} {cand}: png not made: {e}"),
+                        }
+                    }
                     println!(
                         "| {name} | {cand} | {} | {iterations} | {smooth_s:.2} | {cpu:.1} | {:.2} | {:.4} | {} |",
                         rep.cells, rep.mu_ge_0_8_percent, rep.min_alpha_over_mean, rep.smoothing
