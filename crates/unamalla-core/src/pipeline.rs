@@ -30,6 +30,9 @@
 //!    patches in parallel, [`crate::untangle`]; small problems need far fewer iterations), then
 //!    run one global optimization over the whole merged mesh with the same functional (the limit
 //!    of the thesis's sequence), which starts convex wherever the patches could be untangled.
+//!    By default the start is not the TFI mesh but one prolonged from the same decomposition
+//!    meshed and smoothed with a quarter of the cells ([`crate::multilevel`], nested
+//!    iteration; [`Mesher::coarse_levels`]); the TFI start is kept when that one is not convex.
 //! 8. **report** quality ([`QualityReport`]) and fidelity (area change, Hausdorff distance of
 //!    the mesh boundary to the input region).
 //!
