@@ -8,8 +8,12 @@
 //! ```
 //!
 //! Candidates (`UNAMALLA_STUDY=name,name` selects some):
-//! * `default` — [`default_smooth_options`] (σ = 0.5 first stage, then σ = 0.1 with window
-//!   FTOL + quality plateau, cap 1000);
+//! * `default` — the pipeline's defaults: [`default_smooth_options`] (σ = 0.5 first stage, then
+//!   σ = 0.1 with window FTOL + quality plateau, cap 1000) with
+//!   `unamalla_core::multilevel::DEFAULT_COARSE_LEVELS` coarse levels;
+//! * `tfi` — the same options smoothed from the transfinite start (no coarse level; the
+//!   default before the coarse levels);
+//! * `c2f1` / `c2f2` / `c2f3` — one, two or three coarse levels (a quarter of the cells each);
 //! * `converged` — σ = 0.1 alone with the same stop rules;
 //! * `cap1000` — the stop rules off (FTOL 10⁻¹⁰, GTOL 10⁻⁶, cap 1000): what the old
 //!   smoother reached after 1000 iterations without its clock;
@@ -17,10 +21,19 @@
 //! * `sigma1` — σ continuation: 30 iterations at σ = 1 (H_ω only, Winslow-type), then
 //!   (6.8) σ = 0.1 with the default stop rules;
 //! * `sigma05` — the same with a first stage at σ = 0.5.
+//!
+//! With `UNAMALLA_STUDY_PNG=DIR` every run also writes its μ band picture
+//! (`unamalla_core::render::quality_png`, 800 px) to `DIR/REGION-CANDIDATE.png`.
+//!
+//! All candidates but `default` and `c2f*` run without coarse levels. The progress line of the
+//! coarse levels (cells and iterations per level) is printed under the table row.
 
+use std::cell::RefCell;
+use std::rc::Rc;
 use std::time::Instant;
 
 use unamalla_core::io::{read_region_geojson, PartSelector};
+use unamalla_core::multilevel::DEFAULT_COARSE_LEVELS;
 use unamalla_core::optim::{Control, Monitor, SmoothOptions, StopRules};
 use unamalla_core::pipeline::{default_smooth_options, Mesher, Stage};
 
@@ -34,7 +47,7 @@ fn cpu_seconds() -> f64 {
     (tick(11) + tick(12)) / 100.0
 }
 
-fn candidates() -> Vec<(&'static str, SmoothOptions)> {
+fn candidates() -> Vec<(&'static str, SmoothOptions, usize)> {
     let mut conv = default_smooth_options();
     conv.sigma_continuation.clear();
     let mut cap = conv.clone();
@@ -47,18 +60,25 @@ fn candidates() -> Vec<(&'static str, SmoothOptions)> {
     let mut s05 = default_smooth_options();
     s05.sigma_continuation = vec![0.5];
     s05.continuation_iter = 30;
+    let d = default_smooth_options();
     let all = vec![
-        ("default", default_smooth_options()),
-        ("converged", conv),
-        ("cap1000", cap),
-        ("plateau", plateau),
-        ("sigma1", s1),
-        ("sigma05", s05),
+        ("default", d.clone(), DEFAULT_COARSE_LEVELS),
+        ("tfi", d.clone(), 0),
+        ("c2f1", d.clone(), 1),
+        ("c2f2", d.clone(), 2),
+        ("c2f3", d, 3),
+        ("converged", conv, 0),
+        ("cap1000", cap, 0),
+        ("plateau", plateau, 0),
+        ("sigma1", s1, 0),
+        ("sigma05", s05, 0),
     ];
     match std::env::var("UNAMALLA_STUDY") {
         Ok(sel) => {
             let names: Vec<&str> = sel.split(',').collect();
-            all.into_iter().filter(|(n, _)| names.contains(n)).collect()
+            all.into_iter()
+                .filter(|(n, _, _)| names.contains(n))
+                .collect()
         }
         Err(_) => all,
     }
@@ -83,7 +103,7 @@ fn main() {
                 continue;
             }
         };
-        for (cand, opts) in candidates() {
+        for (cand, opts, levels) in candidates() {
             let mut iterations = 0usize;
             let mut count = |_: &Monitor| {
                 iterations += 1;
@@ -91,9 +111,17 @@ fn main() {
             };
             let cpu0 = cpu_seconds();
             let t0 = Instant::now();
+            let coarse_line = Rc::new(RefCell::new(String::new()));
+            let line = coarse_line.clone();
             let r = Mesher::new()
                 .cells(cells)
                 .smooth_options(opts)
+                .coarse_levels(levels)
+                .on_progress(move |stage, msg| {
+                    if stage == Stage::Smooth && msg.starts_with("coarse levels") {
+                        *line.borrow_mut() = msg.to_string();
+                    }
+                })
                 .mesh_observed(&region, &mut count);
             let cpu = cpu_seconds() - cpu0;
             let _wall = t0.elapsed();
@@ -105,12 +133,24 @@ fn main() {
                         .iter()
                         .find(|(s, _)| *s == Stage::Smooth)
                         .map_or(f64::NAN, |(_, t)| *t);
+                    if let Ok(dir) = std::env::var("UNAMALLA_STUDY_PNG") {
+                        let png = unamalla_core::render::quality_png(&r.mesh, None, 800);
+                        match png.map(|b| std::fs::write(format!("{dir}/{name}-{cand}.png"), b)) {
+                            Ok(Ok(())) => {}
+                            Ok(Err(e)) => eprintln!("{name} {cand}: png not written: {e}"),
+                            Err(e) => eprintln!("{name} {cand}: png not made: {e}"),
+                        }
+                    }
                     println!(
                         "| {name} | {cand} | {} | {iterations} | {smooth_s:.2} | {cpu:.1} | {:.2} | {:.4} | {} |",
                         rep.cells, rep.mu_ge_0_8_percent, rep.min_alpha_over_mean, rep.smoothing
                     );
                 }
                 Err(e) => println!("| {name} | {cand} | error: {e} |"),
+            }
+            let line = coarse_line.borrow();
+            if !line.is_empty() {
+                eprintln!("  {name} {cand}: {line}");
             }
         }
     }

@@ -37,6 +37,7 @@ pub mod corners;
 pub mod curves;
 pub mod flat_corners;
 pub mod hex;
+pub mod multilevel;
 pub mod output;
 pub mod pde;
 pub mod pipeline;

@@ -30,6 +30,9 @@
 //!    patches in parallel, [`crate::untangle`]; small problems need far fewer iterations), then
 //!    run one global optimization over the whole merged mesh with the same functional (the limit
 //!    of the thesis's sequence), which starts convex wherever the patches could be untangled.
+//!    By default the start is not the TFI mesh but one prolonged from the same decomposition
+//!    meshed and smoothed with a quarter of the cells ([`crate::multilevel`], nested
+//!    iteration; [`Mesher::coarse_levels`]); the TFI start is kept when that one is not convex.
 //! 8. **report** quality ([`QualityReport`]) and fidelity (area change, Hausdorff distance of
 //!    the mesh boundary to the input region).
 //!
@@ -167,6 +170,7 @@ pub struct Mesher {
     progress: Option<ProgressFn>,
     strategy: Strategy,
     allow_non_convex: bool,
+    coarse_levels: usize,
 }
 
 impl Default for Mesher {
@@ -267,6 +271,7 @@ impl Mesher {
             progress: None,
             strategy: Strategy::Cuts,
             allow_non_convex: false,
+            coarse_levels: crate::multilevel::DEFAULT_COARSE_LEVELS,
         }
     }
     /// The decomposition strategy (default [`Strategy::Cuts`]).
@@ -357,6 +362,15 @@ impl Mesher {
     /// (default `false`; the CLI's `--allow-non-convex`).
     pub fn allow_non_convex(mut self, allow: bool) -> Self {
         self.allow_non_convex = allow;
+        self
+    }
+    /// Coarse levels of the smoothing (default [`crate::multilevel::DEFAULT_COARSE_LEVELS`];
+    /// 0: smooth from the transfinite start): the decomposition is meshed again with a quarter
+    /// of the cells per level, smoothed, and the result prolonged to the level above as its
+    /// start ([`crate::multilevel`]). Only for the cuts strategy and cell-count or cell-size
+    /// requests; a prolonged start that is not convex is discarded.
+    pub fn coarse_levels(mut self, levels: usize) -> Self {
+        self.coarse_levels = levels;
         self
     }
     /// A progress callback called at the start of every stage.
@@ -624,6 +638,30 @@ impl Mesher {
         // the explicit time limit (if any) counts from the start of the stage
         let t_stage = Instant::now();
         sopts.time_limit = self.time_limit;
+        // 7-. a start prolonged from smoothed coarse levels ([`crate::multilevel`]); when it is
+        // used, the untangling below has nothing to do (the start is convex)
+        let coarse = match (&counts, submapping.is_none()) {
+            (Some(c), true) => crate::multilevel::coarse_start(
+                &decomposition,
+                self.size,
+                &mesh,
+                &c.counts,
+                &sopts,
+                crate::multilevel::CoarseLevels {
+                    levels: self.coarse_levels,
+                    flat_corner_deficit: self.flat_corner_deficit,
+                },
+                observer,
+            )?,
+            _ => None,
+        };
+        if let Some(c) = &coarse {
+            self.stage(Stage::Smooth, &c.summary());
+            if c.accepted {
+                mesh.global_mut().nodes_mut().copy_from_slice(&c.nodes);
+                sopts = crate::multilevel::polish_options(&sopts);
+            }
+        }
         // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
         // block boundaries ([`crate::untangle`]): small problems converge in far fewer
         // iterations than the global one, the work is bounded by iteration limits (not
