@@ -205,6 +205,9 @@ pub fn chord_layout_cuts(
     // and the piece is left to Algorithm 1 alone, while that lowers the number of such blocks
     let tol = crate::decomposition::boundary_tol(region);
     for _ in 0..WITHDRAW_ROUNDS {
+        if d.blocks.len() > WITHDRAW_MAX_BLOCKS {
+            break;
+        }
         let bad = inadmissible_blocks(&d, &opts.tolerances);
         if bad.is_empty() {
             break;
@@ -246,6 +249,10 @@ pub fn chord_layout_cuts(
 
 /// Rounds of layout-cut withdrawal in [`chord_layout_cuts`].
 const WITHDRAW_ROUNDS: usize = 3;
+/// Layouts with more blocks than this get no withdrawal: each round rebuilds the whole layout
+/// (work linear in its blocks and rings), so the withdrawal's work is bounded by
+/// `WITHDRAW_ROUNDS` rebuilds of a layout of at most this size.
+const WITHDRAW_MAX_BLOCKS: usize = 600;
 
 /// The blocks of `d` that are not admissible ([`Decomposition::block_admissible`]).
 fn inadmissible_blocks(d: &Decomposition, tol: &Tolerances) -> Vec<usize> {
