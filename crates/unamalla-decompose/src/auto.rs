@@ -278,17 +278,12 @@ pub fn layout_from_cuts(
         b.apply_cut(p, q, tol, Step::Chord);
     }
     b.protected_cuts = b.cuts.len();
-    let leaves: Vec<usize> = (0..b.nodes.len())
-        .filter(|&n| b.pieces[n].is_some())
-        .collect();
-    for n in leaves {
-        b.run_auto(n)?;
-    }
+    b.run_auto_on_leaves()?;
     b.finish()
 }
 
-/// A straight cut that splits block `blk` of `d` (a decomposition of `region`) across its narrowest place relative to its
-/// size: the chord with the highest `min(A₁, A₂)/w²` of at least `min_score` (module `chords`)
+/// A straight cut that splits block `blk` of `d` (a decomposition of `region`) across its
+/// narrowest place relative to its size: the chord with the highest `min(A₁, A₂)/w²` of at least `min_score` (module `chords`)
 /// whose ends lie on the region boundary or on one of the `layout` cuts (so that
 /// [`layout_from_cuts`] can replay it after them), meeting the boundary at no less than
 /// [`crate::chords::MIN_END_ANGLE_DEG`], and leaving at least `min_area` on its smaller side.
@@ -515,6 +510,17 @@ impl<'a> Builder<'a> {
     pub fn new_cut(&mut self, a: DVec2, b: DVec2) -> usize {
         self.cuts.push((a, b));
         self.cuts.len() - 1
+    }
+
+    /// Runs Algorithm 1 ([`Builder::run_auto`]) on every current leaf piece.
+    pub fn run_auto_on_leaves(&mut self) -> Result<(), DecomposeError> {
+        let leaves: Vec<usize> = (0..self.nodes.len())
+            .filter(|&n| self.pieces[n].is_some())
+            .collect();
+        for n in leaves {
+            self.run_auto(n)?;
+        }
+        Ok(())
     }
 
     /// Algorithm 1 on the subtree rooted at `root` (a leaf).

@@ -323,12 +323,7 @@ fn load_cuts(
     b.protected_cuts = b.cuts.len();
     b.auto_repair = complete;
     if complete {
-        let leaves: Vec<usize> = (0..b.nodes.len())
-            .filter(|&n| b.pieces[n].is_some())
-            .collect();
-        for n in leaves {
-            b.run_auto(n)?;
-        }
+        b.run_auto_on_leaves()?;
     }
     b.finish()
 }
