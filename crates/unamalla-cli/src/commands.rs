@@ -126,6 +126,7 @@ pub struct MeshArgs {
     pub min_hole_area: Option<f64>,
     pub no_simplify: bool,
     pub feature_factor: f64,
+    pub neck_factor: f64,
     pub time_limit: Option<f64>,
     pub part: Option<PartArg>,
     pub allow_non_convex: bool,
@@ -156,6 +157,9 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     }
     if !(a.feature_factor.is_finite() && a.feature_factor >= 0.0) {
         usage!("--feature-factor must be a number ≥ 0");
+    }
+    if !(a.neck_factor.is_finite() && a.neck_factor >= 0.0) {
+        usage!("--neck-factor must be a number ≥ 0");
     }
     if !matches!(a.strategy.as_str(), "cuts" | "submap" | "auto") {
         usage!(
@@ -258,7 +262,9 @@ fn mesh_part(
         _ => mesher,
     };
     mesher = mesher.boundary_density(a.boundary_density);
-    mesher = mesher.feature_factor(a.feature_factor);
+    mesher = mesher
+        .feature_factor(a.feature_factor)
+        .neck_factor(a.neck_factor);
     if let Some(t) = a.time_limit {
         if !(t.is_finite() && t >= 0.0) {
             bail!("--time-limit must be a number of seconds ≥ 0");

@@ -129,6 +129,11 @@ enum Command {
         /// target cell sizes (0 keeps every feature the simplification kept).
         #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_FEATURE_FACTOR)]
         feature_factor: f64,
+        /// Cut off spits and fill inlets behind a neck narrower than this many target cell
+        /// sizes (and thinner than that on average); 0 keeps them. Each cut is listed in
+        /// report.json's notes.
+        #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_NECK_FACTOR)]
+        neck_factor: f64,
         /// Stop smoothing after this many seconds of wall-clock time (status "STOP by TIME
         /// LIMIT"). By default there is no limit: smoothing stops on convergence, so the mesh
         /// does not depend on the machine.
@@ -338,6 +343,7 @@ fn run(cli: Cli) -> Result<()> {
             min_hole_area,
             no_simplify,
             feature_factor,
+            neck_factor,
             time_limit,
             part,
             allow_non_convex,
@@ -356,6 +362,7 @@ fn run(cli: Cli) -> Result<()> {
             min_hole_area,
             no_simplify,
             feature_factor,
+            neck_factor,
             time_limit,
             part,
             allow_non_convex,

@@ -39,6 +39,7 @@ impl Settings {
             if a.no_simplify { "off" } else { "on" }.into(),
         ));
         rows.push(("feature factor".into(), a.feature_factor.to_string()));
+        rows.push(("neck factor".into(), a.neck_factor.to_string()));
         if let Some(f) = &a.gis.feature {
             rows.push(("feature".into(), f.clone()));
         }

@@ -83,6 +83,7 @@
 pub mod criteria;
 mod error;
 pub mod mpp;
+mod necks;
 pub mod noise;
 mod overlay;
 mod removal;
@@ -90,6 +91,7 @@ mod simplify;
 
 pub use error::ContourError;
 pub use mpp::{minimum_perimeter_polygon, MppOptions, MppResult};
+pub use necks::{cut_narrow_necks, NeckCut, NeckKind, NeckOptions};
 pub use noise::{detect_noise, detect_noise_region, log_area_profile, NoiseReport};
 pub use overlay::overlay_svg;
 pub use simplify::{

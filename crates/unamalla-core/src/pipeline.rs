@@ -7,7 +7,11 @@
 //!    then remove the boundary features smaller than the target cell size `h` (modified-area
 //!    measure ζ < `c·h²`, [`DEFAULT_FEATURE_FACTOR`] `c = 5`,
 //!    [`unamalla_contour::remove_features_below`]): a block side zig-zagging at the cell scale
-//!    admits no convex cells, so such features would leave folded cells behind;
+//!    admits no convex cells, so such features would leave folded cells behind; and cut off
+//!    the spits and inlets behind a neck narrower than a cell ([`DEFAULT_NECK_FACTOR`],
+//!    [`unamalla_contour::cut_narrow_necks`]): a tongue narrower than a cell gets blocks whose
+//!    sides are shorter than a cell, and their point counts force rows of tiny cells across
+//!    the neighbouring blocks;
 //! 2. **decompose** into admissible blocks by cuts and choose four corners per block
 //!    (`unamalla-decompose`);
 //! 3. **compatible counts** ([`crate::curves`]): every block side is split into curves Q_j
@@ -113,6 +117,15 @@ pub enum Strategy {
 /// (or a smaller factor) to keep them.
 pub const DEFAULT_FEATURE_FACTOR: f64 = 5.0;
 
+/// Default factor of [`Mesher::neck_factor`]: spits and inlets behind a neck narrower than
+/// one target cell (`1.0·h`) whose mean width is below one cell are cut off at the neck
+/// ([`unamalla_contour::cut_narrow_necks`]). A tongue narrower than a cell admits no convex
+/// cells of the requested size: the layout gave it blocks whose sides are shorter than a cell,
+/// and their counts forced rows of cells with 1–2 % of the mean area across the neighbouring
+/// blocks (Texas at 20,000 cells: two barrier spits, μ ≥ 0.8 on 79.8 % of the cells; see
+/// docs/results.md).
+pub const DEFAULT_NECK_FACTOR: f64 = 1.0;
+
 /// Largest accepted relative area change of the mesh against the **input** region (20 %),
 /// checked when no hole was dropped on purpose: the default simplification keeps the change
 /// below 2 % on the bundled regions (docs/results.md), and the feature removal may drop a
@@ -166,6 +179,7 @@ pub struct Mesher {
     boundary_density: f64,
     time_limit: Option<f64>,
     feature_factor: f64,
+    neck_factor: f64,
     flat_corner_deficit: f64,
     progress: Option<ProgressFn>,
     strategy: Strategy,
@@ -267,6 +281,7 @@ impl Mesher {
             boundary_density: 1.0,
             time_limit: None,
             feature_factor: DEFAULT_FEATURE_FACTOR,
+            neck_factor: DEFAULT_NECK_FACTOR,
             flat_corner_deficit: crate::flat_corners::DEFAULT_MIN_DEFICIT_DEG,
             progress: None,
             strategy: Strategy::Cuts,
@@ -294,6 +309,15 @@ impl Mesher {
     /// `h`), without simplification, or with a decomposition file.
     pub fn feature_factor(mut self, c: f64) -> Self {
         self.feature_factor = if c.is_finite() { c.max(0.0) } else { 0.0 };
+        self
+    }
+    /// Spits and inlets behind a neck narrower than `c·h` (and thinner than that on average)
+    /// are cut off at the neck after the feature removal, `h` the target cell size (default
+    /// [`DEFAULT_NECK_FACTOR`]; 0 disables; see [`unamalla_contour::cut_narrow_necks`]). Not
+    /// applied where [`Mesher::feature_factor`] is not. The cuts are listed in the report's
+    /// notes.
+    pub fn neck_factor(mut self, c: f64) -> Self {
+        self.neck_factor = if c.is_finite() { c.max(0.0) } else { 0.0 };
         self
     }
     /// About `n` cells.
@@ -427,10 +451,20 @@ impl Mesher {
             }
             _ => simplified.clone(),
         };
+        let (mesh_region, necks) = match (h, &self.simplify) {
+            (Some(h), Some(_)) if self.feature_factor > 0.0 && self.neck_factor > 0.0 => {
+                unamalla_contour::cut_narrow_necks(
+                    &mesh_region,
+                    &unamalla_contour::NeckOptions::new(self.neck_factor * h),
+                )?
+            }
+            _ => (mesh_region, Vec::new()),
+        };
         Ok(PreparedRegion {
             simplified,
             mesh_region,
             holes_dropped,
+            necks,
         })
     }
 
@@ -519,6 +553,7 @@ impl Mesher {
         self.stage(Stage::Simplify, "simplifying the contour");
         let prepared = self.prepare_region(region)?;
         let holes_dropped = prepared.holes_dropped;
+        let neck_notes: Vec<String> = prepared.necks.iter().map(|c| c.to_string()).collect();
         // a decomposition file fits either region: ours (saved by a previous run) fits the one
         // without features, one made by hand for the simplified region fits the other
         // (validated here, once: the error names the simplified region when neither fits)
@@ -762,7 +797,7 @@ impl Mesher {
                 .unwrap_or_default(),
             layout: layout_choice,
             quality,
-            notes: counts_notes,
+            notes: neck_notes.into_iter().chain(counts_notes).collect(),
             verification: Default::default(),
         };
         Ok(MeshResult {
@@ -786,6 +821,8 @@ pub struct PreparedRegion {
     pub mesh_region: Region,
     /// Input holes dropped by the simplification (indices in input order).
     pub holes_dropped: Vec<usize>,
+    /// Spits and inlets cut off at their necks ([`Mesher::neck_factor`]).
+    pub necks: Vec<unamalla_contour::NeckCut>,
 }
 
 /// Largest relative area change (a fraction) the pipeline accepts from the contour
