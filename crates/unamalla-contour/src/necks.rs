@@ -21,6 +21,12 @@
 //! 4. the ring itself is not thin (`2A/P ≥ w` for the whole ring: an island narrower than a
 //!    cell is left to the hole filter).
 //!
+//! A **sharp tip** — a vertex whose two edges make a wedge of angle `φ` below
+//! [`NeckOptions::tip_angle`] (θ₋ = 40°: such a vertex cannot be a corner of an admissible
+//! block) — is a neck too: it is `w` wide at depth `d = w / (2 sin(φ/2))`, and when both edges
+//! are longer than `d` the chord there replaces the tip (a cape loses, a notch gains the
+//! triangle `½ d² sin φ`).
+//!
 //! On the outer ring a piece of region material is a **spit** (peninsula, barrier island
 //! attached at one end: the region loses its area) and a piece of exterior is an **inlet**
 //! (river mouth, fjord, narrow bay: the region gains it); on a hole the roles swap. The
@@ -52,6 +58,11 @@ pub struct NeckOptions {
     pub max_piece_share: f64,
     /// Rounds of cutting (default 8): a round applies every non-overlapping cut.
     pub max_rounds: usize,
+    /// Wedge angle (radians) below which a sharp tip whose two edges are longer than the
+    /// truncation depth is truncated where it is `width` wide (default 40°, the critical angle
+    /// θ₋ of the decomposition below which a vertex cannot be an admissible block corner;
+    /// 0 disables).
+    pub tip_angle: f64,
 }
 
 impl NeckOptions {
@@ -61,6 +72,14 @@ impl NeckOptions {
             width,
             max_piece_share: 0.02,
             max_rounds: 8,
+            tip_angle: 40f64.to_radians(),
+        }
+    }
+    /// The same options with the tip angle `radians` ([`NeckOptions::tip_angle`]).
+    pub fn with_tip_angle(self, radians: f64) -> Self {
+        Self {
+            tip_angle: radians,
+            ..self
         }
     }
 }
@@ -125,6 +144,9 @@ struct Candidate {
     removed: usize,
     /// Point inserted after `keep` (the chord's end on an edge), unless it is a ring vertex.
     insert: Option<DVec2>,
+    /// A sharp tip truncated: the chord's two ends, inserted after `keep` in ring order (then
+    /// `insert` is `None` and `removed` is 1: the tip vertex).
+    tip: Option<(DVec2, DVec2)>,
     /// The chord's ends.
     chord: (DVec2, DVec2),
     /// Area of the piece.
@@ -238,18 +260,24 @@ fn apply(rings: &[Vec<DVec2>], chosen: &[Candidate]) -> Vec<Vec<DVec2>> {
             let n = ring.len();
             let mut removed = vec![false; n];
             let mut insert_after: Vec<Option<DVec2>> = vec![None; n];
+            let mut tips: Vec<Option<(DVec2, DVec2)>> = vec![None; n];
             for c in chosen.iter().filter(|c| c.ring == r) {
                 for k in 1..=c.removed {
                     removed[(c.keep + k) % n] = true;
                 }
                 insert_after[c.keep] = c.insert;
+                tips[c.keep] = c.tip;
             }
-            let mut out = Vec::with_capacity(n);
+            let mut out = Vec::with_capacity(n + 2 * chosen.len());
             for v in 0..n {
                 if !removed[v] {
                     out.push(ring[v]);
                     if let Some(q) = insert_after[v] {
                         out.push(q);
+                    }
+                    if let Some((u, w)) = tips[v] {
+                        out.push(u);
+                        out.push(w);
                     }
                 }
             }
@@ -303,7 +331,7 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
     let mut out = Vec::new();
     for (r, ring) in rings.iter().enumerate() {
         let n = ring.len();
-        if n < 5 {
+        if n < 3 {
             continue;
         }
         let chains = Chains::new(ring);
@@ -343,6 +371,7 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
                         // q = p_j: p_j stays (one fewer removed, nothing inserted)
                         removed: if q == a { m_f - 1 } else { m_f },
                         insert: (q != a && q != b).then_some(q),
+                        tip: None,
                         chord: (p, q),
                         area: sa_f.abs(),
                         signed_area: sa_f,
@@ -356,6 +385,7 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
                         keep: if q == b { s_b } else { j },
                         removed: if q == b { m_b - 1 } else { m_b },
                         insert: (q != a && q != b).then_some(q),
+                        tip: None,
                         chord: (q, p),
                         area: sa_b.abs(),
                         signed_area: sa_b,
@@ -371,8 +401,7 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
                     continue;
                 }
                 // conditions 1 and 2
-                if 2.0 * cand.area / perimeter >= w
-                    || cand.area > opts.max_piece_share * ring_area
+                if 2.0 * cand.area / perimeter >= w || cand.area > opts.max_piece_share * ring_area
                 {
                     continue;
                 }
@@ -385,10 +414,76 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
                 }
                 best = Some(cand);
             }
+            if let Some(t) = tip_candidate(rings, index, r, i, opts) {
+                if best.as_ref().is_none_or(|b| b.area < t.area) {
+                    best = Some(t);
+                }
+            }
             out.extend(best);
         }
     }
     out
+}
+
+/// The truncation of a sharp tip at vertex `i` of ring `r`: the wedge between the two edges at
+/// `p_i` has angle `φ < opts.tip_angle` (on the region's side or on the exterior's: a sharp
+/// cape or a sharp notch); it is `w` wide at depth `d = w / (2 sin(φ/2))` from the tip, and the
+/// chord there replaces `p_i` when both edges are longer than `d` (shorter edges leave the
+/// neck to a neighbouring vertex's chord). Conditions 2 and 3 as for the other cuts.
+fn tip_candidate(
+    rings: &[Vec<DVec2>],
+    index: &SegmentIndex,
+    r: usize,
+    i: usize,
+    opts: &NeckOptions,
+) -> Option<Candidate> {
+    let ring = &rings[r];
+    let n = ring.len();
+    let (a, p, b) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+    let (ea, eb) = (a - p, b - p);
+    let (la, lb) = (ea.length(), eb.length());
+    if !(la > 0.0 && lb > 0.0) {
+        return None;
+    }
+    let phi = ea.perp_dot(eb).abs().atan2(ea.dot(eb));
+    if !(phi > 0.0 && phi < opts.tip_angle) {
+        return None;
+    }
+    let d = opts.width / (2.0 * (0.5 * phi).sin());
+    if !(d < la && d < lb) {
+        return None;
+    }
+    let (u, v) = (p + ea * (d / la), p + eb * (d / lb));
+    // the triangle u, p, v in ring order (a → u → p → v → b)
+    let signed = 0.5 * ((p - u).perp_dot(v - u));
+    let ring_area = unamalla_mesh::region::signed_area(ring).abs();
+    if signed.abs() > opts.max_piece_share * ring_area {
+        return None;
+    }
+    let prev = (i + n - 1) % n;
+    let blocked = index.candidates(u, v).any(|e| {
+        if e.ring == r && (e.edge == i || e.edge == prev) {
+            return false;
+        }
+        let (s, t) = index.edge(e);
+        open_segment_hits(u, v, s, t)
+    });
+    let tri = Polygon::from_points_unchecked(vec![u, p, v]);
+    let encloses = rings
+        .iter()
+        .enumerate()
+        .any(|(k, other)| k != r && tri.locate(other[0]) == Location::Inside);
+    (!blocked && !encloses).then_some(Candidate {
+        ring: r,
+        keep: prev,
+        removed: 1,
+        insert: None,
+        tip: Some((u, v)),
+        chord: (u, v),
+        area: signed.abs(),
+        signed_area: signed,
+        piece: (i, 0, u), // not used for a tip (its triangle is checked above)
+    })
 }
 
 impl Candidate {
@@ -543,6 +638,36 @@ mod tests {
             .unwrap()
             .1
             .is_empty());
+    }
+
+    #[test]
+    fn a_sharp_cape_is_truncated_where_it_is_one_width_wide() {
+        // isosceles triangle with a 30° apex at the origin and legs of 100: the apex is cut at
+        // depth d = w / (2 sin 15°) along both legs; the tip triangle has area ½ d² sin 30°
+        let apex = 30f64.to_radians();
+        let ring = vec![
+            DVec2::ZERO,
+            DVec2::new(100.0, 0.0),
+            DVec2::new(100.0 * apex.cos(), 100.0 * apex.sin()),
+        ];
+        let region = Region::new(ring, vec![]).unwrap();
+        let w = 1.0;
+        let d = w / (2.0 * (0.5 * apex).sin());
+        let (out, cuts) = cut_narrow_necks(&region, &NeckOptions::new(w)).unwrap();
+        assert_eq!(cuts.len(), 1, "{cuts:?}");
+        assert_eq!(cuts[0].kind, NeckKind::Spit);
+        assert!((cuts[0].width - w).abs() < 1e-12);
+        let tip_area = 0.5 * d * d * apex.sin();
+        assert!((cuts[0].area - tip_area).abs() < 1e-12);
+        assert!((region.area() - out.area() - tip_area).abs() < 1e-9);
+        assert_eq!(out.outer().len(), 4);
+        assert!(out.outer().points().iter().all(|p| p.length() >= d - 1e-9));
+        // the 75° corners stay; with the tip angle off nothing is cut
+        let off = NeckOptions {
+            tip_angle: 0.0,
+            ..NeckOptions::new(w)
+        };
+        assert!(cut_narrow_necks(&region, &off).unwrap().1.is_empty());
     }
 
     #[test]

@@ -20,7 +20,9 @@
 //! * `plateau` — the quality plateau alone (no window FTOL);
 //! * `sigma1` — σ continuation: 30 iterations at σ = 1 (H_ω only, Winslow-type), then
 //!   (6.8) σ = 0.1 with the default stop rules;
-//! * `sigma05` — the same with a first stage at σ = 0.5.
+//! * `sigma05` — the same with a first stage at σ = 0.5;
+//! * `final02` / `final03` / `final05` — the default options with the final σ = 0.2, 0.3 or
+//!   0.5 instead of 0.1 (no coarse level).
 //!
 //! With `UNAMALLA_STUDY_PNG=DIR` every run also writes its μ band picture
 //! (`unamalla_core::render::quality_png`, 800 px) to `DIR/REGION-CANDIDATE.png`.
@@ -61,7 +63,26 @@ fn candidates() -> Vec<(&'static str, SmoothOptions, usize)> {
     s05.sigma_continuation = vec![0.5];
     s05.continuation_iter = 30;
     let d = default_smooth_options();
+    let final_sigma = |sigma: f64| {
+        let mut o = default_smooth_options();
+        o.functional = unamalla_core::optim::SmoothFunctional::block_smoothing(sigma);
+        o
+    };
     let all = vec![
+        ("final02", final_sigma(0.2), 0),
+        ("final03", final_sigma(0.3), 0),
+        ("final05", final_sigma(0.5), 0),
+        (
+            "default05",
+            {
+                let mut o = final_sigma(0.5);
+                o.sigma_continuation.clear();
+                o
+            },
+            DEFAULT_COARSE_LEVELS,
+        ),
+        ("final07", final_sigma(0.7), 0),
+        ("final10", final_sigma(1.0), 0),
         ("default", d.clone(), DEFAULT_COARSE_LEVELS),
         ("tfi", d.clone(), 0),
         ("c2f1", d.clone(), 1),

@@ -269,7 +269,7 @@ pub struct MeshReport {
 
 impl Mesher {
     /// Defaults: about 20,000 cells, default simplification, automatic decomposition, (6.8)
-    /// smoothing with σ = 0.1 and no boundary density.
+    /// smoothing with σ = [`DEFAULT_SIGMA`] and no boundary density.
     pub fn new() -> Self {
         Self {
             size: MeshSize::default(),
@@ -455,7 +455,11 @@ impl Mesher {
             (Some(h), Some(_)) if self.feature_factor > 0.0 && self.neck_factor > 0.0 => {
                 unamalla_contour::cut_narrow_necks(
                     &mesh_region,
-                    &unamalla_contour::NeckOptions::new(self.neck_factor * h),
+                    // sharp tips are not truncated: measured at 20,000 cells (θ₋ = 40°) it
+                    // raised chesapeake-bay and norway above 90 % but lost 3 points on
+                    // danish-straits and gulf-of-finland and left newfoundland with a cell
+                    // outside the region (31 of 34 regions at target against 33; docs/results.md)
+                    &unamalla_contour::NeckOptions::new(self.neck_factor * h).with_tip_angle(0.0),
                 )?
             }
             _ => (mesh_region, Vec::new()),
@@ -880,23 +884,36 @@ fn nearly_touching(region: &Region, rel: f64) -> bool {
     })
 }
 
-/// The pipeline's smoothing defaults: (6.8) with σ = 0.1 and truncated Newton (trust region)
-/// with the inner CG capped at 40 iterations — on meshes of ~20,000 cells an inexact Newton
-/// step is far cheaper than an exact one and the outer iteration still converges — ended by
-/// the convergence tests [`DEFAULT_STOP_RULES`] and at most 1000 iterations per phase; no
-/// time limit. A σ-continuation first stage of at most 30 iterations at σ = 0.5 comes before
-/// the σ = 0.1 run: measured with the `smooth_study` example (docs/benchmarks.md, issue #23)
-/// it is the only candidate whose μ ≥ 0.8 share was within 0.5 points of (or above) the old
-/// 15 s-budget smoother on every region tried (hippo 94.6 vs 94.8 %, texas 90.1 vs 88.6 %,
-/// chesapeake-bay 86.3 vs 83.8 %, gulf-of-mexico 86.7 vs 83.1 %); the plain σ = 0.1 run
-/// with the same stop rules lost 0.9 points on hippo and 4.4 on texas.
+/// Weight σ of H_ω in the pipeline's smoothing functional (6.8), `(1 − σ)·F_AO + σ·H_ω`.
+///
+/// The thesis's examples use σ = 0.1 (seed 000, the Laguna Honda region); the pipeline uses
+/// 0.5. Measured with the `smooth_study` example on the 34 development regions (docs/results.md,
+/// "Smoothing weight σ"): at σ = 0.1 the converged meshes of large open blocks whose cells are
+/// anisotropic (the compatible counts make them 1.5–2.5 times longer than wide) are **buckled**
+/// — grid lines in herringbone waves, with diagonal stripes of sheared cells (μ 0.6–0.8) a few
+/// cells apart — because the area–orthogonality term is nearly singular for diagonal shear
+/// waves (its Hessian's Rayleigh quotient is about `2θ⁴` for wave number θ, against `16θ²`
+/// for the other polarisation; the test `area_orthogonality_hessian_is_weak_for_diagonal_shear_waves`
+/// of `unamalla-functionals`) and H_ω at weight 0.1 does not hold them; running the σ = 0.1
+/// smoother to its FTOL (88 iterations instead of 51) does not remove the stripes. With
+/// σ = 0.5 the μ ≥ 0.8 share rose on **every** region at 5,000 cells (by 0.2–7 points; 22 → 26
+/// regions at ≥ 90 %) and at 20,000 cells (by 0.1–3.9 points; 30 → 33) with about half the
+/// iterations; σ = 0.3 and σ = 0.7 were close behind, σ = 1 (H_ω alone) lost on the
+/// silhouettes (crow 74.7 % at 5,000 cells).
+pub const DEFAULT_SIGMA: f64 = 0.5;
+
+/// The pipeline's smoothing defaults: (6.8) with σ = [`DEFAULT_SIGMA`] and truncated Newton
+/// (trust region) with the inner CG capped at 40 iterations — on meshes of ~20,000 cells an
+/// inexact Newton step is far cheaper than an exact one and the outer iteration still
+/// converges — ended by the convergence tests [`DEFAULT_STOP_RULES`] and at most 1000
+/// iterations per phase; no time limit, no σ continuation (the former first stage at σ = 0.5
+/// before a σ = 0.1 run is now the whole run).
 pub fn default_smooth_options() -> SmoothOptions {
     let mut o = SmoothOptions::default();
     o.solver.cg_max_iter = 40;
     o.solver.max_iter = 1000;
     o.solver.stop = DEFAULT_STOP_RULES;
-    o.sigma_continuation = vec![0.5];
-    o.continuation_iter = 30;
+    o.functional = unamalla_optim::SmoothFunctional::block_smoothing(DEFAULT_SIGMA);
     o
 }
 
