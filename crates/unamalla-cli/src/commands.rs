@@ -467,10 +467,55 @@ pub fn eval(path: &Path, name: &str, omega: Option<f64>, k: Option<f64>, raw: bo
 }
 
 /// `unamalla smooth`.
+/// The options of `unamalla smooth` besides the files.
+#[derive(Debug, Clone, Default)]
+pub struct SmoothFlags {
+    /// `--functional`.
+    pub functional: String,
+    /// `--solver`.
+    pub solver: String,
+    /// `--sigma` (the functional's default if `None`).
+    pub sigma: Option<f64>,
+    /// `--lbfgs-memory`.
+    pub lbfgs_memory: Option<usize>,
+    /// `--pointwise-mode`.
+    pub pointwise_mode: Option<String>,
+    /// `--homotopy`.
+    pub homotopy: Option<String>,
+    /// `--presmooth`.
+    pub presmooth: usize,
+}
+
+impl SmoothFlags {
+    /// The library options these flags select (typed errors for unknown names and bad values).
+    pub fn options(&self) -> Result<SmoothOptions> {
+        let mut functional: optim::SmoothFunctional = self.functional.parse()?;
+        if let Some(s) = self.sigma {
+            functional = functional.with_sigma(s)?;
+        }
+        let mut opts = SmoothOptions {
+            functional,
+            presmooth: self.presmooth,
+            ..SmoothOptions::default()
+        };
+        opts.solver.solver = self.solver.parse::<optim::solver::Solver>()?;
+        if let Some(m) = self.lbfgs_memory {
+            opts.solver.lbfgs_memory = m;
+        }
+        if let Some(p) = &self.pointwise_mode {
+            opts.solver.pointwise_mode = p.parse()?;
+        }
+        if let Some(h) = &self.homotopy {
+            opts.schedule = h.parse()?;
+        }
+        opts.solver.validate()?;
+        Ok(opts)
+    }
+}
+
 pub fn smooth(
     path: &Path,
-    functional: &str,
-    solver: &str,
+    flags: &SmoothFlags,
     out: &Path,
     quiet: bool,
     allow_non_convex: bool,
@@ -484,11 +529,7 @@ pub fn smooth(
         unamalla_core::preflight::COST_PER_SMOOTH_NODE,
         reliability::limit()?,
     )?;
-    let mut opts = SmoothOptions {
-        functional: functional.parse()?,
-        ..SmoothOptions::default()
-    };
-    opts.solver.solver = solver.parse::<optim::solver::Solver>()?;
+    let opts = flags.options()?;
     let mut progress = ProgressObserver::new(Duration::from_millis(200));
     let mut null = NullObserver;
     let observer: &mut dyn Observer = if quiet { &mut null } else { &mut progress };
