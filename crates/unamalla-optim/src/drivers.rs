@@ -355,12 +355,16 @@ struct Init {
 }
 
 /// Common start of the 2D drivers: a `Length` probe functional on `topo` and the convexity of
-/// the start `x`; errors if the boundary does not enclose a positive mean α (ᾱ).
+/// the start `x`; errors if there is no free node or the boundary does not enclose a positive
+/// mean α (ᾱ).
 fn quad_start(
     topo: &Arc<QuadTopology>,
     x: &[f64],
     session: &mut Session<'_>,
 ) -> Result<(QuadFunctional<Kernel2>, crate::monitor::Convexity), OptimError> {
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
     let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
     let c0 = session.convexity(&probe, x);
     let ab = c0.mean;
@@ -480,6 +484,34 @@ fn check_sigma(name: &'static str, s: f64) -> Result<(), OptimError> {
     }
 }
 
+/// UNAMALLA's optional "Previous Smoothness" (González Flores, UNAMALLA thesis, §A.4.3):
+/// `iters` iterations of normalized Length with truncated Newton + line search. Returns the
+/// functional and the solver result if the run was interrupted (stop, time limit), `None`
+/// otherwise (also for `iters = 0`).
+fn length_presmooth(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    iters: usize,
+    solver: &SolverOptions,
+    ab: f64,
+    session: &mut Session<'_>,
+    guard: &QuadLocalGuard,
+) -> Result<Option<(QuadFunctional<Kernel2>, SolveResult)>, OptimError> {
+    if iters == 0 {
+        return Ok(None);
+    }
+    session.set_phase(Phase::Smooth);
+    let n = topo.num_triangles();
+    let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
+    let so = SolverOptions {
+        solver: Solver::TnLs,
+        max_iter: iters,
+        ..solver.clone()
+    };
+    let r = minimize_with(&p, x, &so, session, Some(guard))?;
+    Ok(r.reason.interrupted().then_some((p, r)))
+}
+
 /// Seed 001 Algorithms 4.1/4.2 as implemented in UNAMALLA 2.0 (§4.6.1, §5.4): adaptive `k`
 /// with the double homotopy, then the classic phase. `x` (free-node coordinates of `topo`) is
 /// overwritten with the result.
@@ -512,26 +544,18 @@ pub fn adaptive_k(
     let mut last = None;
     session.guard_threshold = 0.0;
     // 0. pre-smoothing with Length (truncated Newton + line search)
-    if opts.presmooth > 0 {
-        session.set_phase(Phase::Smooth);
-        let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
-        let so = SolverOptions {
-            solver: Solver::TnLs,
-            max_iter: opts.presmooth,
-            ..opts.solver.clone()
-        };
-        let r = minimize_with(&p, x, &so, session, Some(&guard))?;
-        if r.reason.interrupted() {
-            return Ok(report(
-                session,
-                &p,
-                x,
-                &init,
-                messages,
-                Some(r),
-                -opts.k_star,
-            ));
-        }
+    if let Some((p, r)) =
+        length_presmooth(topo, x, opts.presmooth, &opts.solver, ab, session, &guard)?
+    {
+        return Ok(report(
+            session,
+            &p,
+            x,
+            &init,
+            messages,
+            Some(r),
+            -opts.k_star,
+        ));
     }
     // 1. homotopy in k
     session.set_phase(Phase::Homotopic);
@@ -1110,28 +1134,17 @@ pub fn classic_combination(
     opts: &ClassicOptions,
     session: &mut Session<'_>,
 ) -> Result<SmoothReport, OptimError> {
-    if topo.num_vars() == 0 {
-        return Err(OptimError::NoFreeNodes);
-    }
+    let (_probe, c0) = quad_start(topo, x, session)?;
     let n = topo.num_triangles();
     let guard = QuadLocalGuard::new(topo.clone());
-    let (_probe, c0) = quad_start(topo, x, session)?;
     let ab = c0.mean;
     let kernel = opts.combination.kernel(opts.sigma, n, ab)?;
     let (init, messages) = start_record(&c0);
     session.guard_threshold = 0.0;
-    if opts.presmooth > 0 {
-        session.set_phase(Phase::Smooth);
-        let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
-        let so = SolverOptions {
-            solver: Solver::TnLs,
-            max_iter: opts.presmooth,
-            ..opts.solver.clone()
-        };
-        let r = minimize_with(&p, x, &so, session, Some(&guard))?;
-        if r.reason.interrupted() {
-            return Ok(report(session, &p, x, &init, messages, Some(r), opts.eps));
-        }
+    if let Some((p, r)) =
+        length_presmooth(topo, x, opts.presmooth, &opts.solver, ab, session, &guard)?
+    {
+        return Ok(report(session, &p, x, &init, messages, Some(r), opts.eps));
     }
     session.set_phase(Phase::Classic);
     let p = QuadFunctional::new(topo.clone(), kernel);

@@ -47,22 +47,20 @@ fn fixture() -> StructuredGrid2 {
 }
 
 fn run(schedule: HomotopySchedule) -> (Vec<f64>, bool, usize) {
+    run_with(&AdaptiveKOptions {
+        schedule,
+        ..Default::default()
+    })
+}
+
+fn run_with(opts: &AdaptiveKOptions) -> (Vec<f64>, bool, usize) {
     let g = fixture();
     let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
     let mut x = topo.initial_x();
     let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Kernel2::Length);
     let mut obs = NullObserver;
     let mut s = Session::new(&probe, &x, &mut obs);
-    let r = adaptive_k(
-        &topo,
-        &mut x,
-        &AdaptiveKOptions {
-            schedule,
-            ..Default::default()
-        },
-        &mut s,
-    )
-    .unwrap();
+    let r = adaptive_k(&topo, &mut x, opts, &mut s).unwrap();
     (x, r.convex, r.initial_inocon)
 }
 
@@ -86,14 +84,7 @@ fn every_schedule_untangles_the_folded_ivanenko_grid() {
     // the path is really used: some schedule gives another mesh than the linear one
     assert!(differs > 0);
     // and the default is the linear homotopy (5.20), bit for bit
-    let g = fixture();
-    let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
-    let mut x = topo.initial_x();
-    let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Kernel2::Length);
-    let mut obs = NullObserver;
-    let mut s = Session::new(&probe, &x, &mut obs);
-    adaptive_k(&topo, &mut x, &AdaptiveKOptions::default(), &mut s).unwrap();
-    assert_eq!(x, x_lin);
+    assert_eq!(run_with(&AdaptiveKOptions::default()).0, x_lin);
 }
 
 /// Corner legs `(a, b)` of every cell of a structured grid (cell `(i,j)` counter-clockwise,
