@@ -7,7 +7,8 @@
 //! Here, with the same candidate vertices as the scoring (interior angle below θ_max, or below
 //! θ_lim when fewer than four qualify):
 //!
-//! 1. `H` = the candidates that are vertices of the convex hull of the ring;
+//! 1. `H` = the candidates that are vertices of the convex hull of the ring
+//!    ([`unamalla_mesh::geometry::convex_hull`], exact orientation);
 //! 2. the **diametral pair** `p, q` = the two vertices of `H` farthest apart;
 //! 3. on each of the two boundary chains `p → q` and `q → p` one more corner, from `H` if the
 //!    chain has a hull candidate and from all candidates otherwise, the pair `(a, b)` that
@@ -22,6 +23,7 @@
 
 use std::f64::consts::PI;
 
+use unamalla_mesh::geometry::convex_hull;
 use unamalla_mesh::DVec2;
 
 use crate::corners::{select_corners, CornerWeights};
@@ -36,40 +38,6 @@ pub enum CornerChoice {
     Scoring,
     /// The thesis's convex-hull diametral heuristic (this module, Méndez Cruz 2023 §5.1.1).
     Diametral,
-}
-
-/// Convex hull of `pts` (indices, counter-clockwise, collinear points left out), Andrew's
-/// monotone chain.
-fn hull(pts: &[DVec2]) -> Vec<usize> {
-    let mut idx: Vec<usize> = (0..pts.len()).collect();
-    idx.sort_by(|&a, &b| {
-        pts[a]
-            .x
-            .total_cmp(&pts[b].x)
-            .then(pts[a].y.total_cmp(&pts[b].y))
-    });
-    idx.dedup_by(|a, b| pts[*a] == pts[*b]);
-    if idx.len() < 3 {
-        return idx;
-    }
-    let cross = |o: usize, a: usize, b: usize| (pts[a] - pts[o]).perp_dot(pts[b] - pts[o]);
-    let mut h: Vec<usize> = Vec::with_capacity(2 * idx.len());
-    for pass in 0..2 {
-        let start = h.len();
-        let seq: Box<dyn Iterator<Item = &usize>> = if pass == 0 {
-            Box::new(idx.iter())
-        } else {
-            Box::new(idx.iter().rev())
-        };
-        for &i in seq {
-            while h.len() >= start + 2 && cross(h[h.len() - 2], h[h.len() - 1], i) <= 0.0 {
-                h.pop();
-            }
-            h.push(i);
-        }
-        h.pop();
-    }
-    h
 }
 
 /// The corner score F of [`crate::corners`] for the ascending tuple `c`.
@@ -122,7 +90,7 @@ pub(crate) fn select_diametral(ring: &[DVec2], w: &CornerWeights) -> Option<([us
         return None;
     }
     let mut on_hull = vec![false; n];
-    for i in hull(ring) {
+    for i in convex_hull(ring) {
         on_hull[i] = is_cand[i];
     }
     let h: Vec<usize> = (0..n).filter(|&i| on_hull[i]).collect();
@@ -266,19 +234,5 @@ mod tests {
             select_corners(&tri, &w),
             select_corners(&tri, &CornerWeights::default())
         );
-    }
-
-    #[test]
-    fn hull_of_a_square_with_an_edge_point() {
-        let pts = vec![
-            v(0.0, 0.0),
-            v(1.0, 0.0),
-            v(2.0, 0.0),
-            v(2.0, 2.0),
-            v(0.0, 2.0),
-        ];
-        let mut h = hull(&pts);
-        h.sort_unstable();
-        assert_eq!(h, vec![0, 2, 3, 4]);
     }
 }
