@@ -182,7 +182,8 @@ enum Command {
         /// Mesh file.
         mesh: PathBuf,
         /// Functional / driver: ao-homega (default), homega, karea-length, ksmooth-area, karea,
-        /// ksmooth, area-length (t-Area–Length), area-ortho (t-Area–Orthogonality, weight 0.5).
+        /// ksmooth, area-length (t-Area–Length), area-ortho (t-Area–Orthogonality, weight 0.5),
+        /// ivanenko (Σ((ε − α)₊)², ε = 0.01ᾱ: untangling only, no smoothing).
         #[arg(long, default_value = "ao-homega")]
         functional: String,
         /// Solver: tn-tr, tn-ls, lbfgs, pointwise.

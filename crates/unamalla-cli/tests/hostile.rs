@@ -936,6 +936,20 @@ fn fast_cases() -> Vec<Case> {
         &[],
     ));
     v.push(case(
+        "smooth --functional ivanenko untangles",
+        &[
+            "smooth",
+            &tangled,
+            "--functional",
+            "ivanenko",
+            "-o",
+            "{out}",
+            "--quiet",
+        ],
+        0,
+        &[],
+    ));
+    v.push(case(
         "smooth pointwise by components, t3 homotopy",
         &[
             "smooth",

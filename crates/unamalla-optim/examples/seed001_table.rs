@@ -7,15 +7,15 @@
 //! source's remaining rows (docs/results.md, "Seed 001 options"): the homotopy paths `t²`, `t³`,
 //! `sin(πt/2)` (González Flores, UNAMALLA thesis, §5.3), L-BFGS with `m = 3`, pointwise Newton by
 //! components, and the classic combinations t-Area–Length (σ = 0.5, 0.9) and
-//! t-Area–Orthogonality (Table 5.1).
+//! t-Area–Orthogonality (Table 5.1), and Ivanenko's convex-mesh functional (§2.2 (2.50)).
 
 use std::sync::Arc;
 
 use unamalla_functionals::{Kernel2, QuadFunctional, QuadTopology};
 use unamalla_mesh::StructuredGrid2;
 use unamalla_optim::drivers::{
-    adaptive_k, classic_combination, omega_continuation, AdaptiveKOptions, ClassicCombination,
-    ClassicOptions, HomotopySchedule, OmegaOptions,
+    adaptive_k, classic_combination, ivanenko_untangle, omega_continuation, AdaptiveKOptions,
+    ClassicCombination, ClassicOptions, HomotopySchedule, OmegaOptions,
 };
 use unamalla_optim::fixtures::{cuad2pp, ivanenko, one_hole, perturbed};
 use unamalla_optim::monitor::{NullObserver, Session};
@@ -94,6 +94,7 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
     enum Opt {
         Adaptive(&'static str, HomotopySchedule, SolverOptions),
         Classic(&'static str, ClassicCombination, f64),
+        Ivanenko(&'static str),
     }
     let tn = SolverOptions::new(Solver::TnTr);
     let opts = vec![
@@ -143,6 +144,7 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
             ClassicCombination::AreaOrthogonality,
             0.5,
         ),
+        Opt::Ivanenko("ivanenko ε = 0.01, tn-tr"),
     ];
     for (name, grid) in fixtures {
         let topo = Arc::new(QuadTopology::from_mesh(grid).expect("topology"));
@@ -166,6 +168,9 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
                         &mut s,
                     );
                     (label, r)
+                }
+                Opt::Ivanenko(label) => {
+                    (label, ivanenko_untangle(&topo, &mut x, 0.01, &tn, &mut s))
                 }
                 Opt::Classic(label, c, sigma) => {
                     let r = classic_combination(

@@ -83,6 +83,8 @@
 //!   Flores, UNAMALLA thesis, §5.3 (5.16)–(5.18)).
 //! * [`classic_combination`]: the classic t-Area–Length and t-Area–Orthogonality
 //!   combinations of the same thesis (§5.2 Table 5.1), which do not untangle.
+//! * [`ivanenko_untangle`]: Ivanenko's convex-mesh functional `Σ((ε − α)₊)²` (same thesis,
+//!   §2.2 (2.50)).
 //! * [`omega_continuation`](drivers::omega_continuation) /
 //!   [`omega_continuation_hex`](drivers::omega_continuation_hex): seed 004 §3.4 Algorithm A.
 //! * [`coplanarity_continuation`](drivers::coplanarity_continuation): seed 004 §4.2
@@ -119,9 +121,9 @@ pub mod status;
 
 pub use coarse_to_fine::{smooth_coarse_to_fine, CoarseToFineOptions, CoarseToFineReport};
 pub use drivers::{
-    classic_combination, homotopy_weight, smooth, smooth_each, smooth_hex, ClassicCombination,
-    ClassicOptions, HexDriver, HexSmoothOptions, HomotopySchedule, KFunctional, SmoothFunctional,
-    SmoothOptions, SmoothReport,
+    classic_combination, homotopy_weight, ivanenko_untangle, smooth, smooth_each, smooth_hex,
+    ClassicCombination, ClassicOptions, HexDriver, HexSmoothOptions, HomotopySchedule, KFunctional,
+    SmoothFunctional, SmoothOptions, SmoothReport,
 };
 pub use error::OptimError;
 pub use linalg::Preconditioner;

@@ -183,3 +183,43 @@ fn classic_smooth_options_parse_and_keep_a_convex_start_convex() {
         .with_sigma(0.5)
         .is_err());
 }
+
+#[test]
+fn ivanenko_functional_untangles_the_folded_ivanenko_grid_to_eps_convexity() {
+    // Σ((ε_I − α)₊)² is 0 exactly when α ≥ ε_I everywhere; the driver targets ε_I = 2εᾱ, so
+    // from the folded 11 × 11 start the run must end ε-convex (α₋ > 0.01ᾱ) with F ≈ 0
+    let mut g = fixture();
+    let r = smooth(
+        &mut g,
+        &SmoothOptions {
+            functional: "ivanenko".parse().unwrap(),
+            ..Default::default()
+        },
+        &mut NullObserver,
+    )
+    .unwrap();
+    assert!(r.initial_inocon > 0);
+    assert!(
+        r.convex && r.eps_convex,
+        "{:?} {} {}",
+        r.status,
+        r.alfamin / r.alpha_bar,
+        r.f
+    );
+    assert!(r.alfamin >= 0.01 * r.alpha_bar * (1.0 - 1e-9));
+    assert!(r.f.abs() < 1e-6, "{}", r.f);
+    // an ε-convex start is left alone
+    let before = g.clone();
+    let r2 = smooth(
+        &mut g,
+        &SmoothOptions {
+            functional: SmoothFunctional::Ivanenko,
+            ..Default::default()
+        },
+        &mut NullObserver,
+    )
+    .unwrap();
+    assert_eq!(r2.iterations(), 0);
+    assert_eq!(g.nodes(), before.nodes());
+    assert!(SmoothFunctional::Ivanenko.with_sigma(0.5).is_err());
+}
