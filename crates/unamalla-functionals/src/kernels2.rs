@@ -1071,8 +1071,9 @@ impl TriKernel for KArea {
 /// Ivanenko's functional for a convex initial mesh: `((ε − α)₊)²` per corner triangle, with
 /// `(t)₊ = max(0, t)` and `ε > 0`.
 ///
-/// Source: G. González Flores, *UNAMALLA: funcionales discretos armónicos, de área y adaptivos*
-/// (thesis, UNAM, c. 2001), §2.2, eq. (2.50), after S. A. Ivanenko's convex-mesh functional
+/// Source: the UNAMALLA thesis (UNAM, c. 2001; author presumably G. González Flores; discrete
+/// harmonic, area and adaptive functionals and the Unamalla 2.0 manual — the text available to
+/// us carries no title page), §2.2, eq. (2.50), after S. A. Ivanenko's convex-mesh functional
 /// `I_{I0} = Σ_{i,j} Σ_{k=1..4} ((ε − J(Δ_ij^{(k)}))₊)²`. Here `J(Δ)` is the triangle Jacobian
 /// in this crate's convention, `α = det(a, b)` (the doubled signed area). The thesis prints the
 /// term as `(ε − J(Δ)₊)²`; the reading used here puts the positive part around the whole

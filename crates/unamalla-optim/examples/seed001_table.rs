@@ -4,10 +4,11 @@
 //! `cargo run --release -p unamalla-optim --example seed001_table`
 //!
 //! With the argument `options` it prints instead the table of the options added for the
-//! source's remaining rows (docs/results.md, "Seed 001 options"): the homotopy paths `t²`, `t³`,
-//! `sin(πt/2)` (González Flores, UNAMALLA thesis, §5.3), L-BFGS with `m = 3`, pointwise Newton by
-//! components, and the classic combinations t-Area–Length (σ = 0.5, 0.9) and
-//! t-Area–Orthogonality (Table 5.1), and Ivanenko's convex-mesh functional (§2.2 (2.50)).
+//! source's remaining rows (docs/results.md, section "Seed 001 options: homotopy paths, …"):
+//! the paths `t²`, `t³`, `sin(πt/2)` (González Flores, UNAMALLA thesis, §5.3), L-BFGS with
+//! `m = 3`, pointwise Newton by components, the classic combinations t-Area–Length (σ = 0.5,
+//! 0.9) and t-Area–Orthogonality (Table 5.1), and Ivanenko's convex-mesh functional (§2.2
+//! (2.50)).
 
 use std::sync::Arc;
 
