@@ -473,10 +473,55 @@ pub fn eval(path: &Path, name: &str, omega: Option<f64>, k: Option<f64>, raw: bo
 }
 
 /// `unamalla smooth`.
+/// The options of `unamalla smooth` besides the files.
+#[derive(Debug, Clone, Default)]
+pub struct SmoothFlags {
+    /// `--functional`.
+    pub functional: String,
+    /// `--solver`.
+    pub solver: String,
+    /// `--sigma` (the functional's default if `None`).
+    pub sigma: Option<f64>,
+    /// `--lbfgs-memory`.
+    pub lbfgs_memory: Option<usize>,
+    /// `--pointwise-mode`.
+    pub pointwise_mode: Option<String>,
+    /// `--homotopy`.
+    pub homotopy: Option<String>,
+    /// `--presmooth`.
+    pub presmooth: usize,
+}
+
+impl SmoothFlags {
+    /// The library options these flags select (typed errors for unknown names and bad values).
+    pub fn options(&self) -> Result<SmoothOptions> {
+        let mut functional: optim::SmoothFunctional = self.functional.parse()?;
+        if let Some(s) = self.sigma {
+            functional = functional.with_sigma(s)?;
+        }
+        let mut opts = SmoothOptions {
+            functional,
+            presmooth: self.presmooth,
+            ..SmoothOptions::default()
+        };
+        opts.solver.solver = self.solver.parse::<optim::solver::Solver>()?;
+        if let Some(m) = self.lbfgs_memory {
+            opts.solver.lbfgs_memory = m;
+        }
+        if let Some(p) = &self.pointwise_mode {
+            opts.solver.pointwise_mode = p.parse()?;
+        }
+        if let Some(h) = &self.homotopy {
+            opts.schedule = h.parse()?;
+        }
+        opts.solver.validate()?;
+        Ok(opts)
+    }
+}
+
 pub fn smooth(
     path: &Path,
-    functional: &str,
-    solver: &str,
+    flags: &SmoothFlags,
     out: &Path,
     quiet: bool,
     allow_non_convex: bool,
@@ -490,11 +535,7 @@ pub fn smooth(
         unamalla_core::preflight::COST_PER_SMOOTH_NODE,
         reliability::limit()?,
     )?;
-    let mut opts = SmoothOptions {
-        functional: functional.parse()?,
-        ..SmoothOptions::default()
-    };
-    opts.solver.solver = solver.parse::<optim::solver::Solver>()?;
+    let opts = flags.options()?;
     let mut progress = ProgressObserver::new(Duration::from_millis(200));
     let mut null = NullObserver;
     let observer: &mut dyn Observer = if quiet { &mut null } else { &mut progress };
@@ -665,4 +706,86 @@ pub fn decompose(a: DecomposeArgs) -> Result<()> {
         d.cuts.len()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod smooth_flag_tests {
+    use super::*;
+    use optim::drivers::{ClassicCombination, HomotopySchedule};
+    use optim::{KFunctional, PointwiseMode, SmoothFunctional, Solver};
+
+    fn flags(functional: &str, solver: &str) -> SmoothFlags {
+        SmoothFlags {
+            functional: functional.into(),
+            solver: solver.into(),
+            ..SmoothFlags::default()
+        }
+    }
+
+    #[test]
+    fn every_flag_reaches_the_library_options() {
+        let o = SmoothFlags {
+            sigma: Some(0.9),
+            homotopy: Some("sine".into()),
+            presmooth: 3,
+            ..flags("karea-length", "lbfgs")
+        };
+        let o = SmoothFlags {
+            lbfgs_memory: Some(3),
+            pointwise_mode: Some("components".into()),
+            ..o
+        }
+        .options()
+        .unwrap();
+        assert_eq!(
+            o.functional,
+            SmoothFunctional::AdaptiveK {
+                functional: KFunctional::KAreaLength,
+                sigma: 0.9
+            }
+        );
+        assert_eq!(o.schedule, HomotopySchedule::Sine);
+        assert_eq!(o.presmooth, 3);
+        assert_eq!(o.solver.solver, Solver::Lbfgs);
+        assert_eq!(o.solver.lbfgs_memory, 3);
+        assert_eq!(o.solver.pointwise_mode, PointwiseMode::Components);
+        // defaults: the functional's own σ, linear homotopy, memory 5, simultaneous
+        let d = flags("area-length", "tn-tr").options().unwrap();
+        assert_eq!(
+            d.functional,
+            SmoothFunctional::Classic {
+                combination: ClassicCombination::AreaLength,
+                sigma: 0.5
+            }
+        );
+        assert_eq!(d.schedule, HomotopySchedule::Linear);
+        assert_eq!(d.solver.lbfgs_memory, 5);
+        assert_eq!(d.solver.pointwise_mode, PointwiseMode::Simultaneous);
+    }
+
+    #[test]
+    fn bad_flags_are_errors() {
+        let bad = |f: SmoothFlags| f.options().is_err();
+        assert!(bad(SmoothFlags {
+            sigma: Some(-0.1),
+            ..flags("ao-homega", "tn-tr")
+        }));
+        assert!(bad(SmoothFlags {
+            sigma: Some(0.7),
+            ..flags("area-ortho", "tn-tr")
+        }));
+        assert!(bad(SmoothFlags {
+            sigma: Some(0.5),
+            ..flags("homega", "tn-tr")
+        }));
+        assert!(bad(SmoothFlags {
+            lbfgs_memory: Some(0),
+            ..flags("ao-homega", "lbfgs")
+        }));
+        assert!(bad(SmoothFlags {
+            homotopy: Some("t4".into()),
+            ..flags("karea-length", "tn-tr")
+        }));
+        assert!(bad(flags("nonsense", "tn-tr")));
+    }
 }

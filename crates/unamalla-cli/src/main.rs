@@ -7,7 +7,9 @@
 //!   [--cells N | --density d | --cell-size h] [--boundary-density w] [--min-hole-area A]
 //!   -o <outdir> [--json] [--quiet]`
 //! * `unamalla eval <mesh> --functional NAME [--omega w] [--k k] [--raw] [--json]`
-//! * `unamalla smooth <mesh> [--functional NAME] [--solver tn-tr|tn-ls|lbfgs|pointwise] -o out`
+//! * `unamalla smooth <mesh> [--functional NAME] [--solver tn-tr|tn-ls|lbfgs|pointwise] [--sigma σ]
+//!   [--lbfgs-memory m] [--pointwise-mode simultaneous|components] [--homotopy linear|t2|t3|sine]
+//!   [--presmooth N] -o out`
 //! * `unamalla simplify <region> --method NAME [--epsilon e] [--delta d] -o out.geojson [--svg f]`
 //! * `unamalla decompose <region> [--from file.json] [--no-simplify] [--cells N] -o decomposition.json [--svg out.svg]`
 //!   (decomposes the region `unamalla mesh` would: its default simplification first)
@@ -184,12 +186,32 @@ enum Command {
     Smooth {
         /// Mesh file.
         mesh: PathBuf,
-        /// Functional / driver: ao-homega (default), homega, karea-length, ksmooth-area, karea, ksmooth.
+        /// Functional / driver: ao-homega (default), homega, karea-length, ksmooth-area, karea,
+        /// ksmooth, area-length (t-Area–Length), area-ortho (t-Area–Orthogonality, weight 0.5),
+        /// ivanenko (Σ((ε − α)₊)², ε = 0.01ᾱ: untangling only, no smoothing).
         #[arg(long, default_value = "ao-homega")]
         functional: String,
         /// Solver: tn-tr, tn-ls, lbfgs, pointwise.
         #[arg(long, default_value = "tn-tr")]
         solver: String,
+        /// Weight σ in [0, 1]: of H_ω for ao-homega (default 0.1), of the adaptive functional
+        /// for karea-length / ksmooth-area (default 0.5), of t-Area for area-length (default
+        /// 0.5; area-ortho accepts only 0.5).
+        #[arg(long)]
+        sigma: Option<f64>,
+        /// L-BFGS memory m, the number of stored pairs (UNAMALLA: 3 or 5; default 5).
+        #[arg(long)]
+        lbfgs_memory: Option<usize>,
+        /// Pointwise Newton mode: simultaneous (2×2 system, default) or components.
+        #[arg(long)]
+        pointwise_mode: Option<String>,
+        /// Homotopy path σ̃(t) towards the combination for karea-length / ksmooth-area: linear
+        /// (default), t2, t3, sine.
+        #[arg(long)]
+        homotopy: Option<String>,
+        /// Length pre-smoothing iterations ("Previous Smoothness"; default 0).
+        #[arg(long, default_value_t = 0)]
+        presmooth: usize,
         /// Output VTK legacy file.
         #[arg(short, long)]
         output: PathBuf,
@@ -383,13 +405,25 @@ fn run(cli: Cli) -> Result<()> {
             mesh,
             functional,
             solver,
+            sigma,
+            lbfgs_memory,
+            pointwise_mode,
+            homotopy,
+            presmooth,
             output,
             quiet,
             allow_non_convex,
         } => commands::smooth(
             &mesh,
-            &functional,
-            &solver,
+            &commands::SmoothFlags {
+                functional,
+                solver,
+                sigma,
+                lbfgs_memory,
+                pointwise_mode,
+                homotopy,
+                presmooth,
+            },
             &output,
             quiet,
             allow_non_convex,

@@ -850,6 +850,126 @@ fn fast_cases() -> Vec<Case> {
         &["nonsense"],
     ));
     v.push(case(
+        "smooth --functional area-ortho --sigma 0.7 (weight fixed at 0.5)",
+        &[
+            "smooth",
+            &tangled,
+            "--functional",
+            "area-ortho",
+            "--sigma",
+            "0.7",
+            "-o",
+            "{out}",
+        ],
+        1,
+        &["fixed at 0.5"],
+    ));
+    v.push(case(
+        "smooth --sigma 1.5",
+        &["smooth", &tangled, "--sigma", "1.5", "-o", "{out}"],
+        1,
+        &["sigma"],
+    ));
+    v.push(case(
+        "smooth --homotopy t4",
+        &[
+            "smooth",
+            &tangled,
+            "--functional",
+            "karea-length",
+            "--homotopy",
+            "t4",
+            "-o",
+            "{out}",
+        ],
+        1,
+        &["t4", "linear, t2, t3, sine"],
+    ));
+    v.push(case(
+        "smooth --pointwise-mode diagonal",
+        &[
+            "smooth",
+            &tangled,
+            "--pointwise-mode",
+            "diagonal",
+            "-o",
+            "{out}",
+        ],
+        1,
+        &["diagonal", "simultaneous, components"],
+    ));
+    v.push(case(
+        "smooth --lbfgs-memory 0",
+        &[
+            "smooth",
+            &tangled,
+            "--solver",
+            "lbfgs",
+            "--lbfgs-memory",
+            "0",
+            "-o",
+            "{out}",
+        ],
+        1,
+        &["lbfgs_memory"],
+    ));
+    v.push(case(
+        "smooth karea-length, sine homotopy, σ 0.9, L-BFGS m = 3",
+        &[
+            "smooth",
+            &tangled,
+            "--functional",
+            "karea-length",
+            "--homotopy",
+            "sine",
+            "--sigma",
+            "0.9",
+            "--solver",
+            "lbfgs",
+            "--lbfgs-memory",
+            "3",
+            "-o",
+            "{out}",
+            "--quiet",
+        ],
+        0,
+        &[],
+    ));
+    v.push(case(
+        "smooth --functional ivanenko untangles",
+        &[
+            "smooth",
+            &tangled,
+            "--functional",
+            "ivanenko",
+            "-o",
+            "{out}",
+            "--quiet",
+        ],
+        0,
+        &[],
+    ));
+    v.push(case(
+        "smooth pointwise by components, t3 homotopy",
+        &[
+            "smooth",
+            &tangled,
+            "--functional",
+            "ksmooth-area",
+            "--homotopy",
+            "t3",
+            "--solver",
+            "pointwise",
+            "--pointwise-mode",
+            "components",
+            "-o",
+            "{out}",
+            "--quiet",
+        ],
+        0,
+        &[],
+    ));
+    v.push(case(
         "pde --g const:1e300 overflow",
         &["pde", &tangled, "--g", "const:1e300", "-o", "{out}"],
         2,

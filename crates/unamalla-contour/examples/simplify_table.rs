@@ -11,7 +11,6 @@
 //! exterior, closed rings) is parsed here with `serde_json` to stay independent of
 //! `unamalla-io`.
 
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use geo::{Coord, LineString, Polygon, SimplifyVw, SimplifyVwPreserve};
@@ -20,37 +19,9 @@ use unamalla_contour::{
 };
 use unamalla_mesh::{DVec2, Region};
 
-fn load(path: &Path) -> Result<Region, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
-    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-    let geom = match json["type"].as_str() {
-        Some("FeatureCollection") => &json["features"][0]["geometry"],
-        Some("Feature") => &json["geometry"],
-        _ => &json,
-    };
-    if geom["type"] != "Polygon" {
-        return Err(format!("{}: not a Polygon", path.display()));
-    }
-    let rings: Vec<Vec<DVec2>> = geom["coordinates"]
-        .as_array()
-        .ok_or("no coordinates")?
-        .iter()
-        .map(|ring| {
-            ring.as_array()
-                .map(|pts| {
-                    pts.iter()
-                        .filter_map(|p| Some(DVec2::new(p[0].as_f64()?, p[1].as_f64()?)))
-                        .collect()
-                })
-                .unwrap_or_default()
-        })
-        .collect();
-    let mut it = rings.into_iter();
-    let outer = it.next().ok_or("empty polygon")?;
-    Region::new_cleaned(outer, it.collect())
-        .map(|(r, _)| r)
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
+#[path = "common/load.rs"]
+mod load;
+use load::load;
 
 fn to_geo(r: &Region) -> Polygon<f64> {
     let ls = |p: &[DVec2]| {
@@ -135,21 +106,7 @@ fn geo_row(
 }
 
 fn main() {
-    let dir = std::env::args()
-        .nth(1)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../../fixtures/regions"
-            ))
-        });
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "geojson"))
-        .collect();
-    files.sort();
+    let files = load::region_files();
     let mut summary = String::from(
         "| region | rings | vertices | noise (gap, staircase) | visvalingam | areas | radii | modified-areas | modified-radii | three-step | modified-three-step | geo VW | geo VW-preserve |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );

@@ -23,6 +23,11 @@
 //!   [`MIN_CORE_DECAY`] = 0.25 decades: the areas take a few discrete values, as on digital
 //!   curves (integer coordinates: areas are multiples of 1/2), instead of a continuum.
 //!
+//! A vertex counts as collinear (and is left out of the profile, as the thesis plots the
+//! non-collinear vertices only) when `|sin θ| ≤` [`COLLINEAR_SIN`] `= 10⁻⁹` at it: floating-point
+//! round-off leaves points sampled on a straight edge with areas of `10⁻¹³` of the largest,
+//! which an exact `a = 0` test would keep as a 13-decade "gap" on a clean contour.
+//!
 //! Rings with fewer than [`MIN_VERTICES`] = 16 non-collinear vertices are never called noisy.
 //! A profile with a single level (all triangles of equal area, e.g. a regular polygon, or a
 //! pixel chain with a vertex at every pixel) carries no evidence either way and is reported
@@ -30,7 +35,7 @@
 
 use glam::DVec2;
 
-use crate::criteria::triangle_area;
+use crate::criteria::{sin_angle, triangle_area};
 use crate::error::ContourError;
 use crate::Preset;
 
@@ -43,6 +48,8 @@ pub const STEP_DECADES: f64 = 0.05;
 pub const MIN_CORE_DECAY: f64 = 0.25;
 /// Fraction of the core decay carried by steps that makes a staircase.
 pub const STAIRCASE_FRACTION: f64 = 0.5;
+/// `|sin θ|` at or below which a vertex counts as collinear (round-off of points on a line).
+pub const COLLINEAR_SIN: f64 = 1e-9;
 /// Rings with fewer non-collinear vertices than this are reported as not noisy.
 pub const MIN_VERTICES: usize = 16;
 
@@ -82,8 +89,11 @@ pub fn log_area_profile(ring: &[DVec2]) -> Result<(Vec<f64>, usize), ContourErro
         )));
     }
     let mut areas: Vec<f64> = (0..n)
-        .map(|i| triangle_area(ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]))
-        .filter(|&a| a > 0.0)
+        .filter_map(|i| {
+            let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+            let t = triangle_area(a, b, c);
+            (t > 0.0 && sin_angle(a, b, c) > COLLINEAR_SIN).then_some(t)
+        })
         .collect();
     let collinear = n - areas.len();
     areas.sort_by(|a, b| b.total_cmp(a));

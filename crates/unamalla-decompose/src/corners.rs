@@ -34,6 +34,7 @@ use std::f64::consts::PI;
 
 use unamalla_mesh::DVec2;
 
+use crate::corners_diametral::{select_diametral, CornerChoice};
 use crate::geom::{angle_penalty, ring_angle};
 
 /// Weights of the corner score F.
@@ -49,6 +50,9 @@ pub struct CornerWeights {
     pub corner_angle_limit: f64,
     /// M: how many candidates enter the exhaustive 4-tuple search.
     pub candidates: usize,
+    /// The selection: this module's scoring (default) or the thesis's convex-hull diametral
+    /// heuristic ([`crate::corners_diametral`]).
+    pub choice: CornerChoice,
 }
 
 impl Default for CornerWeights {
@@ -59,6 +63,7 @@ impl Default for CornerWeights {
             max_corner_angle: 165f64.to_radians(),
             corner_angle_limit: 170f64.to_radians(),
             candidates: 18,
+            choice: CornerChoice::Scoring,
         }
     }
 }
@@ -66,6 +71,9 @@ impl Default for CornerWeights {
 /// The best corner 4-tuple of a ring and its score F (lower is better), or `None` when the
 /// ring has fewer than four vertices with an interior angle below `w.corner_angle_limit`.
 pub fn select_corners(ring: &[DVec2], w: &CornerWeights) -> Option<([usize; 4], f64)> {
+    if w.choice == CornerChoice::Diametral {
+        return select_diametral(ring, w);
+    }
     let n = ring.len();
     if n < 4 {
         return None;

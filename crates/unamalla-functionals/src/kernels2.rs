@@ -1068,6 +1068,60 @@ impl TriKernel for KArea {
     }
 }
 
+/// Ivanenko's functional for a convex initial mesh: `((ε − α)₊)²` per corner triangle, with
+/// `(t)₊ = max(0, t)` and `ε > 0`.
+///
+/// Source: the UNAMALLA thesis (UNAM, c. 2001; author presumably G. González Flores; discrete
+/// harmonic, area and adaptive functionals and the Unamalla 2.0 manual — the text available to
+/// us carries no title page), §2.2, eq. (2.50), after S. A. Ivanenko's convex-mesh functional
+/// `I_{I0} = Σ_{i,j} Σ_{k=1..4} ((ε − J(Δ_ij^{(k)}))₊)²`. Here `J(Δ)` is the triangle Jacobian
+/// in this crate's convention, `α = det(a, b)` (the doubled signed area). The thesis prints the
+/// term as `(ε − J(Δ)₊)²`; the reading used here puts the positive part around the whole
+/// difference, which is the only one that is zero exactly when every `α ≥ ε` (so a zero value
+/// certifies an ε-convex mesh, and every cell is convex).
+///
+/// Derivatives in `α`: `f′ = −2(ε − α)₊`, `f″ = 2` for `α < ε` and `0` above. The function is
+/// C¹ and piecewise quadratic; `f″` jumps at `α = ε`, where the Hessian returned is the one of
+/// the side `α ≥ ε` (zero). It is finite on every mesh, folded or not, so it needs no
+/// regularization. It has no ideal value (it is 0 on every ε-convex mesh), so
+/// [`Kernel2::normalized`] refuses it; scale it by hand if it is combined with another kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IvanenkoConvex {
+    eps: f64,
+}
+impl IvanenkoConvex {
+    /// `ε` finite and `> 0` (absolute, in units of `α`; e.g. `0.01·ᾱ`).
+    pub fn new(eps: f64) -> Result<Self, FunctionalError> {
+        Ok(Self {
+            eps: check_pos("eps", eps)?,
+        })
+    }
+    /// `ε = eps_rel·ᾱ` for the mean `ᾱ > 0` of the mesh.
+    pub fn relative(eps_rel: f64, alpha_bar: f64) -> Result<Self, FunctionalError> {
+        let ab = check_pos("alpha_bar", alpha_bar)?;
+        Self::new(check_pos("eps_rel", eps_rel)? * ab)
+    }
+    /// The threshold `ε`.
+    pub fn eps(&self) -> f64 {
+        self.eps
+    }
+}
+impl TriKernel for IvanenkoConvex {
+    #[inline(always)]
+    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
+        SP_ALPHA
+    }
+    #[inline(always)]
+    fn eval(&self, s: &TriScalars, order: Order) -> Partials {
+        let d = self.eps - s.alpha;
+        if d > 0.0 {
+            of_alpha([d * d, -2.0 * d, 2.0], order)
+        } else {
+            zero()
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // convexity-guaranteeing kernels
 
@@ -1453,6 +1507,8 @@ pub enum Kernel2 {
     SOmegaEps(SOmegaEps),
     /// [`HOmega`].
     HOmega(HOmega),
+    /// [`IvanenkoConvex`].
+    IvanenkoConvex(IvanenkoConvex),
     /// Any user kernel, e.g. a [`GenericArea`].
     Custom(Arc<dyn TriKernel>),
     /// `Σ wᵢ Kᵢ` (convex combinations of two or more functionals, normalizations).
@@ -1481,6 +1537,7 @@ impl std::fmt::Debug for Kernel2 {
             Kernel2::KArea(k) => write!(f, "{k:?}"),
             Kernel2::SOmegaEps(k) => write!(f, "{k:?}"),
             Kernel2::HOmega(k) => write!(f, "{k:?}"),
+            Kernel2::IvanenkoConvex(k) => write!(f, "{k:?}"),
         }
     }
 }
@@ -1597,6 +1654,7 @@ macro_rules! kernel2_leaf {
             Kernel2::KArea($k) => $e,
             Kernel2::SOmegaEps($k) => $e,
             Kernel2::HOmega($k) => $e,
+            Kernel2::IvanenkoConvex($k) => $e,
             _ => $other,
         }
     };
@@ -1698,6 +1756,7 @@ impl TriKernel for Kernel2 {
             Kernel2::KArea(k) => k.eval(s, order),
             Kernel2::SOmegaEps(k) => k.eval(s, order),
             Kernel2::HOmega(k) => k.eval(s, order),
+            Kernel2::IvanenkoConvex(k) => k.eval(s, order),
         }
     }
     fn terms(&self) -> Terms {

@@ -31,6 +31,7 @@
 //! | [`KArea`] | `1/(k + α)`, C² quadratic below `α̂` | seed 001 (4.23), (4.43) |
 //! | [`SOmegaEps`] | `f(ω(α/ᾱ − ε))`, `f` of (56) | seed 003 §5.3 (55–56), erratum 13 |
 //! | [`HOmega`] | `l·φ_ω(α)`, `φ_ω = 1/α` (α ≥ ω), `(2ω − α)/ω²` below (C¹) | seed 000 §5.5, erratum 10 |
+//! | [`IvanenkoConvex`] | `((ε − α)₊)²` (zero iff every `α ≥ ε`) | González Flores, UNAMALLA thesis, §2.2 (2.50), after Ivanenko |
 //!
 //! plus normalizations ([`Kernel2::normalized`], seed 001 §3.1), weighted sums ([`Sum`],
 //! [`Kernel2::Combination`], e.g. seed 000 (6.8) `(1−σ)F_AO + σH_ω`) and per-cell weights
@@ -94,10 +95,10 @@ pub use hex::{
 };
 pub use kernels2::{
     inv_k, phi_omega, phi_regularized, recommended_alpha_hat, s_function, Area, AreaOrthogonality,
-    CastilloArea, CellWeighted, CornerLanes, GenericArea, HOmega, KArea, KSmoothness, Kernel2,
-    LaneGrad, LanePartials, Length, Order, Orthogonality, Partials, RegularizedInverseArea,
-    RegularizedSmoothness, SArgument, SOmegaEps, Scaled, Smoothness, SpacingWeights, Sum, Terms,
-    TriKernel, TriScalars, WeightedLength, A4P,
+    CastilloArea, CellWeighted, CornerLanes, GenericArea, HOmega, IvanenkoConvex, KArea,
+    KSmoothness, Kernel2, LaneGrad, LanePartials, Length, Order, Orthogonality, Partials,
+    RegularizedInverseArea, RegularizedSmoothness, SArgument, SOmegaEps, Scaled, Smoothness,
+    SpacingWeights, Sum, Terms, TriKernel, TriScalars, WeightedLength, A4P,
 };
 #[cfg(feature = "nalgebra-sparse")]
 pub use nalgebra_sparse_conv::CsrConversionError;

@@ -117,6 +117,18 @@ fn all_kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
             Kernel2::Area.cell_weighted(dens).unwrap(),
         ),
     ];
+    // Ivanenko's ((ε − α)₊)²: ε placed at least 0.05ᾱ away from every α of the grid, so the
+    // finite differences never straddle the kink of f″ at α = ε
+    let mut alphas = vec![0.0; topo.num_triangles()];
+    topo.alphas(x, &mut alphas);
+    if let Some(eps) = (6..=30).map(|i| 0.05 * i as f64 * abar).find(|e| {
+        alphas.iter().all(|a| (a - e).abs() > 0.05 * abar) && alphas.iter().any(|a| a < e)
+    }) {
+        v.push((
+            "ivanenko",
+            Kernel2::IvanenkoConvex(IvanenkoConvex::new(eps).unwrap()),
+        ));
+    }
     if min_abs > 0.05 * abar {
         v.push(("smoothness", Kernel2::Smoothness(Smoothness::new())));
         v.push((

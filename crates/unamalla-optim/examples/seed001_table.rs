@@ -2,15 +2,25 @@
 //! of the seed 001 fixtures and prints the Markdown table of `docs/benchmarks.md`.
 //!
 //! `cargo run --release -p unamalla-optim --example seed001_table`
+//!
+//! With the argument `options` it prints instead the table of the options added for the
+//! source's remaining rows (docs/results.md, section "Seed 001 options: homotopy paths, …"):
+//! the paths `t²`, `t³`, `sin(πt/2)` (González Flores, UNAMALLA thesis, §5.3), L-BFGS with
+//! `m = 3`, pointwise Newton by components, the classic combinations t-Area–Length (σ = 0.5,
+//! 0.9) and t-Area–Orthogonality (Table 5.1), and Ivanenko's convex-mesh functional (§2.2
+//! (2.50)).
 
 use std::sync::Arc;
 
 use unamalla_functionals::{Kernel2, QuadFunctional, QuadTopology};
 use unamalla_mesh::StructuredGrid2;
-use unamalla_optim::drivers::{adaptive_k, omega_continuation, AdaptiveKOptions, OmegaOptions};
+use unamalla_optim::drivers::{
+    adaptive_k, classic_combination, ivanenko_untangle, omega_continuation, AdaptiveKOptions,
+    ClassicCombination, ClassicOptions, HomotopySchedule, OmegaOptions,
+};
 use unamalla_optim::fixtures::{cuad2pp, ivanenko, one_hole, perturbed};
 use unamalla_optim::monitor::{NullObserver, Session};
-use unamalla_optim::solver::{Solver, SolverOptions};
+use unamalla_optim::solver::{PointwiseMode, Solver, SolverOptions};
 
 fn main() {
     let base: Vec<(&str, StructuredGrid2)> = vec![
@@ -22,6 +32,10 @@ fn main() {
     for (name, g) in base {
         fixtures.push((format!("{name} TFI"), g.clone()));
         fixtures.push((format!("{name} TFI perturbed 0.8"), perturbed(&g, 0.8, 7)));
+    }
+    if std::env::args().nth(1).as_deref() == Some("options") {
+        options_table(&fixtures);
+        return;
     }
     println!("| fixture | driver | solver | initial Inocon | iterations (homot.+classic) | time [ms] | final α₋/ᾱ | F | Inocon | all-fixed α ≤ 0 | status |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
@@ -35,11 +49,7 @@ fn main() {
                 let mut s = Session::new(&probe, &x, &mut obs);
                 let so = SolverOptions::new(solver);
                 let rep = if driver == "adaptive-k" {
-                    let ipk = if matches!(solver, Solver::TnTr | Solver::TnLs) {
-                        5
-                    } else {
-                        10
-                    };
+                    let ipk = iters_per_k(solver);
                     adaptive_k(
                         &topo,
                         &mut x,
@@ -68,19 +78,143 @@ fn main() {
                 }
                 .expect("driver");
                 println!(
-                    "| {name} | {driver} | {solver} | {} | {} ({}+{}) | {:.1} | {:.4} | {:.6} | {} | {} | {} |",
-                    rep.initial_inocon,
-                    rep.iterations(),
-                    rep.iter_homotopic,
-                    rep.iter_classic,
-                    rep.elapsed.as_secs_f64() * 1e3,
-                    rep.alfamin_rel(),
-                    rep.f,
-                    rep.inocon,
+                    "| {name} | {driver} | {solver} | {} | {} | {} |",
+                    cells(&rep),
                     rep.fixed_nonpositive,
                     rep.status
                 );
             }
         }
     }
+}
+
+/// The table of the new options: one row per (fixture, option).
+fn options_table(fixtures: &[(String, StructuredGrid2)]) {
+    println!("| fixture | option | initial Inocon | iterations (homot.+classic) | time [ms] | final α₋/ᾱ | F | Inocon | status |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    enum Opt {
+        Adaptive(&'static str, HomotopySchedule, SolverOptions),
+        Classic(&'static str, ClassicCombination, f64),
+        Ivanenko(&'static str),
+    }
+    let tn = SolverOptions::new(Solver::TnTr);
+    let opts = vec![
+        Opt::Adaptive(
+            "karea-length, homotopy t², tn-tr",
+            HomotopySchedule::Square,
+            tn.clone(),
+        ),
+        Opt::Adaptive(
+            "karea-length, homotopy t³, tn-tr",
+            HomotopySchedule::Cube,
+            tn.clone(),
+        ),
+        Opt::Adaptive(
+            "karea-length, homotopy sine, tn-tr",
+            HomotopySchedule::Sine,
+            tn.clone(),
+        ),
+        Opt::Adaptive(
+            "karea-length, linear, lbfgs m = 3",
+            HomotopySchedule::Linear,
+            SolverOptions {
+                lbfgs_memory: 3,
+                ..SolverOptions::new(Solver::Lbfgs)
+            },
+        ),
+        Opt::Adaptive(
+            "karea-length, linear, pointwise by components",
+            HomotopySchedule::Linear,
+            SolverOptions {
+                pointwise_mode: PointwiseMode::Components,
+                ..SolverOptions::new(Solver::Pointwise)
+            },
+        ),
+        Opt::Classic(
+            "area-length σ = 0.5, tn-tr",
+            ClassicCombination::AreaLength,
+            0.5,
+        ),
+        Opt::Classic(
+            "area-length σ = 0.9, tn-tr",
+            ClassicCombination::AreaLength,
+            0.9,
+        ),
+        Opt::Classic(
+            "area-ortho (σ = 0.5), tn-tr",
+            ClassicCombination::AreaOrthogonality,
+            0.5,
+        ),
+        Opt::Ivanenko("ivanenko ε = 0.01, tn-tr"),
+    ];
+    for (name, grid) in fixtures {
+        let topo = Arc::new(QuadTopology::from_mesh(grid).expect("topology"));
+        for o in &opts {
+            let mut x = topo.initial_x();
+            let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+            let mut obs = NullObserver;
+            let mut s = Session::new(&probe, &x, &mut obs);
+            let (label, rep) = match o {
+                Opt::Adaptive(label, schedule, so) => {
+                    let ipk = iters_per_k(so.solver);
+                    let r = adaptive_k(
+                        &topo,
+                        &mut x,
+                        &AdaptiveKOptions {
+                            iters_per_k: ipk,
+                            solver: so.clone(),
+                            schedule: *schedule,
+                            ..Default::default()
+                        },
+                        &mut s,
+                    );
+                    (label, r)
+                }
+                Opt::Ivanenko(label) => {
+                    (label, ivanenko_untangle(&topo, &mut x, 0.01, &tn, &mut s))
+                }
+                Opt::Classic(label, c, sigma) => {
+                    let r = classic_combination(
+                        &topo,
+                        &mut x,
+                        &ClassicOptions {
+                            combination: *c,
+                            sigma: *sigma,
+                            presmooth: 0,
+                            eps: 0.01,
+                            solver: tn.clone(),
+                        },
+                        &mut s,
+                    );
+                    (label, r)
+                }
+            };
+            let rep = rep.expect("driver");
+            println!("| {name} | {label} | {} | {} |", cells(&rep), rep.status);
+        }
+    }
+}
+
+/// Iterations per `k` update: 5 for truncated Newton, 10 otherwise (the benchmark's setting).
+fn iters_per_k(solver: Solver) -> usize {
+    if matches!(solver, Solver::TnTr | Solver::TnLs) {
+        5
+    } else {
+        10
+    }
+}
+
+/// The columns "initial Inocon" … "Inocon" of a row.
+fn cells(rep: &unamalla_optim::SmoothReport) -> String {
+    format!(
+        "{} | {} ({}+{}) | {:.1} | {:.4} | {:.6} | {}",
+        rep.initial_inocon,
+        rep.iterations(),
+        rep.iter_homotopic,
+        rep.iter_classic,
+        rep.elapsed.as_secs_f64() * 1e3,
+        rep.alfamin_rel(),
+        rep.f,
+        rep.inocon,
+    )
 }

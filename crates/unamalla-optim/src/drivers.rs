@@ -23,8 +23,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use unamalla_functionals::{
-    recommended_alpha_hat, HOmega, HexFunctional, HexTopology, KArea, KSmoothness, Kernel2,
-    Problem, QuadFunctional, QuadTopology, Scaling3,
+    recommended_alpha_hat, HOmega, HexFunctional, HexTopology, IvanenkoConvex, KArea, KSmoothness,
+    Kernel2, Problem, QuadFunctional, QuadTopology, Scaling3,
 };
 use unamalla_mesh::{FreeNodes, HasHexCells, HasQuadCells};
 
@@ -51,6 +51,92 @@ pub enum KFunctional {
     KArea,
 }
 
+/// The path `σ̃(t)` of the homotopy between functionals (González Flores, UNAMALLA thesis,
+/// §5.3, eqs. (5.14)–(5.18)): `f̃_c = (1 − σ̃)f₁ + σ̃f_c`, `σ̃` C¹ and increasing on `[0, 1]`
+/// with `σ̃(0) = 0`, `σ̃(1) = 1`. In the double homotopy of §5.4 the parameter is tied to the
+/// adaptive `k`, `t = (k₀ − k)/(k₀ − k*)` ((5.20) is the linear path), so the weight of the
+/// classic functional `f₂` is `σ̂ = (1 − σ)·σ̃(t)` (5.19) ([`homotopy_weight`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum HomotopySchedule {
+    /// `σ̃(t) = t`: the linear homotopy (5.20), UNAMALLA's practical scheme.
+    #[default]
+    Linear,
+    /// `σ̃(t) = t²` (5.16).
+    Square,
+    /// `σ̃(t) = t³` (5.17).
+    Cube,
+    /// `σ̃(t) = sin(πt/2)` (5.18).
+    Sine,
+}
+
+impl HomotopySchedule {
+    /// Every schedule.
+    pub const ALL: [HomotopySchedule; 4] = [
+        HomotopySchedule::Linear,
+        HomotopySchedule::Square,
+        HomotopySchedule::Cube,
+        HomotopySchedule::Sine,
+    ];
+    /// The command-line name (`linear`, `t2`, `t3`, `sine`).
+    pub fn name(self) -> &'static str {
+        match self {
+            HomotopySchedule::Linear => "linear",
+            HomotopySchedule::Square => "t2",
+            HomotopySchedule::Cube => "t3",
+            HomotopySchedule::Sine => "sine",
+        }
+    }
+    /// `σ̃(t)` for `t` clamped to `[0, 1]`.
+    pub fn sigma_tilde(self, t: f64) -> f64 {
+        let t = t.clamp(0.0, 1.0);
+        match self {
+            HomotopySchedule::Linear => t,
+            HomotopySchedule::Square => t * t,
+            HomotopySchedule::Cube => t * t * t,
+            HomotopySchedule::Sine => (0.5 * std::f64::consts::PI * t).sin(),
+        }
+    }
+}
+
+impl std::fmt::Display for HomotopySchedule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for HomotopySchedule {
+    type Err = OptimError;
+    fn from_str(s: &str) -> Result<Self, OptimError> {
+        HomotopySchedule::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| OptimError::UnknownName {
+                what: "homotopy schedule",
+                name: s.to_string(),
+                expected: "linear, t2, t3, sine",
+            })
+    }
+}
+
+/// The weight `σ̂` of the classic functional `f₂` in the double homotopy (González Flores,
+/// UNAMALLA thesis, §5.3–§5.4, (5.19)–(5.20)): `σ̂ = w_final·σ̃(t)` with
+/// `t = (k₀ − k)/(k₀ − k*)` clamped to `[0, 1]` and `w_final = 1 − σ` (σ = weight of the adaptive
+/// `f₁`). If `k` rises again, `t` and `σ̂` fall back with it (the automatic restart of Fig 5.8).
+/// With `k₀ ≤ k*` (the start is already at the floor) the target weight is returned.
+pub fn homotopy_weight(
+    schedule: HomotopySchedule,
+    w_final: f64,
+    k0: f64,
+    k: f64,
+    kstar: f64,
+) -> f64 {
+    if k0 > kstar {
+        w_final * schedule.sigma_tilde((k0 - k) / (k0 - kstar))
+    } else {
+        w_final
+    }
+}
+
 /// Options of [`adaptive_k`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AdaptiveKOptions {
@@ -72,6 +158,9 @@ pub struct AdaptiveKOptions {
     /// Solver options (the classic phase runs with these; the homotopy with
     /// `max_iter = iters_per_k`).
     pub solver: SolverOptions,
+    /// The path `σ̃(t)` of the homotopy towards the combination ([`HomotopySchedule`]).
+    #[serde(default)]
+    pub schedule: HomotopySchedule,
 }
 
 impl Default for AdaptiveKOptions {
@@ -85,6 +174,7 @@ impl Default for AdaptiveKOptions {
             presmooth: 0,
             classic: true,
             solver: SolverOptions::default(),
+            schedule: HomotopySchedule::Linear,
         }
     }
 }
@@ -265,12 +355,16 @@ struct Init {
 }
 
 /// Common start of the 2D drivers: a `Length` probe functional on `topo` and the convexity of
-/// the start `x`; errors if the boundary does not enclose a positive mean α (ᾱ).
+/// the start `x`; errors if there is no free node or the boundary does not enclose a positive
+/// mean α (ᾱ).
 fn quad_start(
     topo: &Arc<QuadTopology>,
     x: &[f64],
     session: &mut Session<'_>,
 ) -> Result<(QuadFunctional<Kernel2>, crate::monitor::Convexity), OptimError> {
+    if topo.num_vars() == 0 {
+        return Err(OptimError::NoFreeNodes);
+    }
     let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
     let c0 = session.convexity(&probe, x);
     let ab = c0.mean;
@@ -390,6 +484,34 @@ fn check_sigma(name: &'static str, s: f64) -> Result<(), OptimError> {
     }
 }
 
+/// UNAMALLA's optional "Previous Smoothness" (González Flores, UNAMALLA thesis, §A.4.3):
+/// `iters` iterations of normalized Length with truncated Newton + line search. Returns the
+/// functional and the solver result if the run was interrupted (stop, time limit), `None`
+/// otherwise (also for `iters = 0`).
+fn length_presmooth(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    iters: usize,
+    solver: &SolverOptions,
+    ab: f64,
+    session: &mut Session<'_>,
+    guard: &QuadLocalGuard,
+) -> Result<Option<(QuadFunctional<Kernel2>, SolveResult)>, OptimError> {
+    if iters == 0 {
+        return Ok(None);
+    }
+    session.set_phase(Phase::Smooth);
+    let n = topo.num_triangles();
+    let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
+    let so = SolverOptions {
+        solver: Solver::TnLs,
+        max_iter: iters,
+        ..solver.clone()
+    };
+    let r = minimize_with(&p, x, &so, session, Some(guard))?;
+    Ok(r.reason.interrupted().then_some((p, r)))
+}
+
 /// Seed 001 Algorithms 4.1/4.2 as implemented in UNAMALLA 2.0 (§4.6.1, §5.4): adaptive `k`
 /// with the double homotopy, then the classic phase. `x` (free-node coordinates of `topo`) is
 /// overwritten with the result.
@@ -422,26 +544,18 @@ pub fn adaptive_k(
     let mut last = None;
     session.guard_threshold = 0.0;
     // 0. pre-smoothing with Length (truncated Newton + line search)
-    if opts.presmooth > 0 {
-        session.set_phase(Phase::Smooth);
-        let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
-        let so = SolverOptions {
-            solver: Solver::TnLs,
-            max_iter: opts.presmooth,
-            ..opts.solver.clone()
-        };
-        let r = minimize_with(&p, x, &so, session, Some(&guard))?;
-        if r.reason.interrupted() {
-            return Ok(report(
-                session,
-                &p,
-                x,
-                &init,
-                messages,
-                Some(r),
-                -opts.k_star,
-            ));
-        }
+    if let Some((p, r)) =
+        length_presmooth(topo, x, opts.presmooth, &opts.solver, ab, session, &guard)?
+    {
+        return Ok(report(
+            session,
+            &p,
+            x,
+            &init,
+            messages,
+            Some(r),
+            -opts.k_star,
+        ));
     }
     // 1. homotopy in k
     session.set_phase(Phase::Homotopic);
@@ -474,11 +588,7 @@ pub fn adaptive_k(
         steps += 1;
         let ah = recommended_alpha_hat(k, am);
         let (f1, f2) = kernels(opts.functional, k, Some(ah), n, ab)?;
-        let w2 = if k0v > kstar {
-            (w_final * (k0v - k) / (k0v - kstar)).clamp(0.0, w_final)
-        } else {
-            w_final
-        };
+        let w2 = homotopy_weight(opts.schedule, w_final, k0v, k, kstar);
         let p = QuadFunctional::new(topo.clone(), combine(f1, f2, w2));
         let r = minimize_with(&p, x, &hom_opts, session, Some(&guard))?;
         last = Some(r);
@@ -951,6 +1061,137 @@ pub fn block_smoothing(
     Ok(rep)
 }
 
+/// The classic combinations of González Flores, UNAMALLA thesis, §5.2 Table 5.1 and App. A
+/// §A.4.3 (the `Area-Lenght` and `Area-Ortho.` entries of the Functional menu), each the convex
+/// combination `σ·F̃₁ + (1 − σ)·F̃₂` of normalized functionals (§5.1; σ is the weight of the
+/// first-named functional, (5.1)–(5.2)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ClassicCombination {
+    /// t-Area – Length: `σ·Σα²/(Nᾱ²) + (1 − σ)·Σl/(2Nᾱ)` (Table 5.1 weights .95, .7, .5; the
+    /// text recommends 0.9 as an automatic value; the menu's default is 0.5).
+    AreaLength,
+    /// t-Area – Orthogonality: `½·Σα²/(Nᾱ²) + ½·Σo²/(Nᾱ²)`, `o = a·b`, with the weight fixed at
+    /// 0.5 (Table 5.1; the weight slider is disabled for it, §A.4.3). By Lagrange's identity
+    /// `α² + o² = |a|²|b|²` this is `Σ|a|²|b|²/(2Nᾱ²)`.
+    AreaOrthogonality,
+}
+
+impl ClassicCombination {
+    /// The fixed weight, if the source fixes one (0.5 for Area–Orthogonality).
+    pub fn fixed_sigma(self) -> Option<f64> {
+        match self {
+            ClassicCombination::AreaLength => None,
+            ClassicCombination::AreaOrthogonality => Some(0.5),
+        }
+    }
+    /// The normalized kernel `σ·F̃₁ + (1 − σ)·F̃₂` for `n` corner triangles of mean `ᾱ`.
+    pub fn kernel(self, sigma: f64, n: usize, alpha_bar: f64) -> Result<Kernel2, OptimError> {
+        check_sigma("sigma", sigma)?;
+        if let Some(f) = self.fixed_sigma() {
+            if sigma != f {
+                return Err(OptimError::InvalidOption {
+                    name: "sigma",
+                    value: sigma,
+                    reason: "the Area-Orthogonality weight is fixed at 0.5",
+                });
+            }
+        }
+        let f2 = match self {
+            ClassicCombination::AreaLength => Kernel2::Length,
+            ClassicCombination::AreaOrthogonality => Kernel2::Orthogonality,
+        };
+        Ok(Kernel2::convex(
+            sigma,
+            Kernel2::Area.normalized(n, alpha_bar)?,
+            f2.normalized(n, alpha_bar)?,
+        )?)
+    }
+}
+
+/// Options of [`classic_combination`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ClassicOptions {
+    /// The pair.
+    pub combination: ClassicCombination,
+    /// σ, the weight of t-Area.
+    pub sigma: f64,
+    /// Length pre-smoothing iterations (0 = "Previous Smoothness: No").
+    pub presmooth: usize,
+    /// ε of the reported ε-convexity (`α₋ > ε·ᾱ`).
+    pub eps: f64,
+    /// Solver options.
+    pub solver: SolverOptions,
+}
+
+/// Minimizes a classic combination ([`ClassicCombination`]) from `x` with the safeguard (a
+/// convex start stays convex). Unlike the adaptive functionals these do not untangle: the
+/// thesis reports none of its four test regions convex with t-Area–Length at σ = .5 or .95
+/// (§5.2, Figs 5.2–5.3); a folded start is minimized without the safeguard and the report says
+/// whether it came out convex.
+pub fn classic_combination(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    opts: &ClassicOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    let (_probe, c0) = quad_start(topo, x, session)?;
+    let n = topo.num_triangles();
+    let guard = QuadLocalGuard::new(topo.clone());
+    let ab = c0.mean;
+    let kernel = opts.combination.kernel(opts.sigma, n, ab)?;
+    let (init, messages) = start_record(&c0);
+    session.guard_threshold = 0.0;
+    if let Some((p, r)) =
+        length_presmooth(topo, x, opts.presmooth, &opts.solver, ab, session, &guard)?
+    {
+        return Ok(report(session, &p, x, &init, messages, Some(r), opts.eps));
+    }
+    session.set_phase(Phase::Classic);
+    let p = QuadFunctional::new(topo.clone(), kernel);
+    let r = minimize_with(&p, x, &opts.solver, session, Some(&guard))?;
+    Ok(report(session, &p, x, &init, messages, Some(r), opts.eps))
+}
+
+/// Untangles with Ivanenko's convex-mesh functional `Σ((ε_I − α)₊)²` (González Flores,
+/// UNAMALLA thesis, §2.2 eq. (2.50), after Ivanenko), scaled by `1/(N·ε_I²)`: the value is 0
+/// exactly when every triangle has `α ≥ ε_I`. The minimization approaches that zero set from
+/// below and the stopping tests end it a hair short (measured on Ivanenko's folded 11 × 11
+/// grid with `ε_I = 0.01ᾱ`: `α₋ = 0.0099994ᾱ`), so the functional is given `ε_I = 2·eps·ᾱ` and
+/// the report's ε-convexity is checked at `eps`. The functional only pushes small triangles
+/// up; it has no smoothing term (the thesis uses it for an initial convex mesh). A start that
+/// is already ε-convex is returned unchanged.
+pub fn ivanenko_untangle(
+    topo: &Arc<QuadTopology>,
+    x: &mut [f64],
+    eps: f64,
+    solver: &SolverOptions,
+    session: &mut Session<'_>,
+) -> Result<SmoothReport, OptimError> {
+    let (probe, c0) = quad_start(topo, x, session)?;
+    if !(eps.is_finite() && eps > 0.0) {
+        return Err(OptimError::InvalidOption {
+            name: "eps",
+            value: eps,
+            reason: "Ivanenko's ε must be finite and > 0",
+        });
+    }
+    let n = topo.num_triangles();
+    let guard = QuadLocalGuard::new(topo.clone());
+    let ab = c0.mean;
+    let (init, mut messages) = start_record(&c0);
+    if c0.eps_convex(eps) {
+        messages.push(Status::InitialGood);
+        return Ok(report(session, &probe, x, &init, messages, None, eps));
+    }
+    let e = 2.0 * eps * ab;
+    let k = Kernel2::IvanenkoConvex(IvanenkoConvex::new(e)?).scaled(1.0 / (n as f64 * e * e));
+    session.set_phase(Phase::Homotopic);
+    session.guard_threshold = 0.0;
+    let p = QuadFunctional::new(topo.clone(), k);
+    let r = minimize_with(&p, x, solver, session, Some(&guard))?;
+    Ok(report(session, &p, x, &init, messages, Some(r), eps))
+}
+
 /// The functional (and driver) of [`smooth`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum SmoothFunctional {
@@ -973,6 +1214,17 @@ pub enum SmoothFunctional {
     },
     /// `homega`: Algorithm A ([`omega_continuation`]).
     OmegaContinuation,
+    /// `ivanenko`: Ivanenko's convex-mesh functional with `ε` = [`SmoothOptions::eps`]
+    /// ([`ivanenko_untangle`]).
+    Ivanenko,
+    /// `area-length`, `area-ortho`: the classic combinations ([`classic_combination`]) with
+    /// weight σ of t-Area.
+    Classic {
+        /// The pair.
+        combination: ClassicCombination,
+        /// σ.
+        sigma: f64,
+    },
 }
 
 impl SmoothFunctional {
@@ -993,6 +1245,50 @@ impl Default for SmoothFunctional {
     }
 }
 
+impl SmoothFunctional {
+    /// The same functional with weight `sigma` (the weight of `H_ω` for `ao-homega`, of the
+    /// adaptive functional for the adaptive pairs, of t-Area for the classic pairs). An error
+    /// for a σ outside `[0, 1]`, for a driver without a weight (`homega`, `karea`, `ksmooth`) and
+    /// for Area–Orthogonality with σ ≠ 0.5 (its weight is fixed).
+    pub fn with_sigma(self, sigma: f64) -> Result<Self, OptimError> {
+        check_sigma("sigma", sigma)?;
+        Ok(match self {
+            SmoothFunctional::BlockSmoothing {
+                density, layers, ..
+            } => SmoothFunctional::BlockSmoothing {
+                sigma,
+                density,
+                layers,
+            },
+            SmoothFunctional::AdaptiveK {
+                functional: f @ (KFunctional::KAreaLength | KFunctional::KSmoothArea),
+                ..
+            } => SmoothFunctional::AdaptiveK {
+                functional: f,
+                sigma,
+            },
+            SmoothFunctional::Classic { combination, .. } => {
+                if combination.fixed_sigma().is_some_and(|f| f != sigma) {
+                    return Err(OptimError::InvalidOption {
+                        name: "sigma",
+                        value: sigma,
+                        reason: "the Area-Orthogonality weight is fixed at 0.5",
+                    });
+                }
+                SmoothFunctional::Classic { combination, sigma }
+            }
+            _ => {
+                return Err(OptimError::InvalidOption {
+                    name: "sigma",
+                    value: sigma,
+                    reason:
+                        "this functional is not a combination (homega, karea, ksmooth, ivanenko)",
+                })
+            }
+        })
+    }
+}
+
 impl FromStr for SmoothFunctional {
     type Err = OptimError;
     fn from_str(s: &str) -> Result<Self, OptimError> {
@@ -1007,11 +1303,20 @@ impl FromStr for SmoothFunctional {
             "karea" => k(KFunctional::KArea),
             "ksmooth" => k(KFunctional::KSmoothness),
             "homega" => SmoothFunctional::OmegaContinuation,
+            "ivanenko" => SmoothFunctional::Ivanenko,
+            "area-length" => SmoothFunctional::Classic {
+                combination: ClassicCombination::AreaLength,
+                sigma: 0.5,
+            },
+            "area-ortho" => SmoothFunctional::Classic {
+                combination: ClassicCombination::AreaOrthogonality,
+                sigma: 0.5,
+            },
             _ => {
                 return Err(OptimError::UnknownName {
                     what: "functional",
                     name: s.to_string(),
-                    expected: "ao-homega, karea-length, ksmooth-area, karea, ksmooth, homega",
+                    expected: "ao-homega, karea-length, ksmooth-area, karea, ksmooth, homega, area-length, area-ortho, ivanenko",
                 })
             }
         })
@@ -1045,6 +1350,9 @@ pub struct SmoothOptions {
     /// Iteration cap of each σ-continuation stage (0 = 50).
     #[serde(default)]
     pub continuation_iter: usize,
+    /// The homotopy path of the adaptive pairs ([`HomotopySchedule`]).
+    #[serde(default)]
+    pub schedule: HomotopySchedule,
 }
 
 impl Default for SmoothOptions {
@@ -1059,6 +1367,7 @@ impl Default for SmoothOptions {
             time_limit: None,
             sigma_continuation: Vec::new(),
             continuation_iter: 0,
+            schedule: HomotopySchedule::Linear,
         }
     }
 }
@@ -1081,6 +1390,7 @@ impl SmoothOptions {
             presmooth: self.presmooth,
             classic,
             solver: self.solver.clone(),
+            schedule: self.schedule,
         }
     }
 }
@@ -1146,6 +1456,19 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
                 ..OmegaOptions::default()
             };
             omega_continuation(&topo, &mut x, &oo, &mut session)?
+        }
+        SmoothFunctional::Ivanenko => {
+            ivanenko_untangle(&topo, &mut x, opts.eps, &opts.solver, &mut session)?
+        }
+        SmoothFunctional::Classic { combination, sigma } => {
+            let co = ClassicOptions {
+                combination: *combination,
+                sigma: *sigma,
+                presmooth: opts.presmooth,
+                eps: opts.eps,
+                solver: opts.solver.clone(),
+            };
+            classic_combination(&topo, &mut x, &co, &mut session)?
         }
     };
     // never hand back more inverted cells than we were given (a run stopped early in the

@@ -78,7 +78,13 @@
 //! * [`adaptive_k`](drivers::adaptive_k): seed 001 Algorithms 4.1/4.2 with the practical update
 //!   `k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01` (§2.5, (4.35)), a few iterations per `k`,
 //!   the C² continuation below `α̂` (erratum 6), the double homotopy `σ̂(k)` (5.20), optional
-//!   Length pre-smoothing, then the classic phase.
+//!   Length pre-smoothing, then the classic phase; the path of the double homotopy is
+//!   selectable ([`HomotopySchedule`]: linear (5.20), `t²`, `t³`, `sin(πt/2)`, González
+//!   Flores, UNAMALLA thesis, §5.3 (5.16)–(5.18)).
+//! * [`classic_combination`]: the classic t-Area–Length and t-Area–Orthogonality
+//!   combinations of the same thesis (§5.2 Table 5.1), which do not untangle.
+//! * [`ivanenko_untangle`]: Ivanenko's convex-mesh functional `Σ((ε − α)₊)²` (same thesis,
+//!   §2.2 (2.50)).
 //! * [`omega_continuation`](drivers::omega_continuation) /
 //!   [`omega_continuation_hex`](drivers::omega_continuation_hex): seed 004 §3.4 Algorithm A.
 //! * [`coplanarity_continuation`](drivers::coplanarity_continuation): seed 004 §4.2
@@ -115,8 +121,9 @@ pub mod status;
 
 pub use coarse_to_fine::{smooth_coarse_to_fine, CoarseToFineOptions, CoarseToFineReport};
 pub use drivers::{
-    smooth, smooth_each, smooth_hex, HexDriver, HexSmoothOptions, KFunctional, SmoothFunctional,
-    SmoothOptions, SmoothReport,
+    classic_combination, homotopy_weight, ivanenko_untangle, smooth, smooth_each, smooth_hex,
+    ClassicCombination, ClassicOptions, HexDriver, HexSmoothOptions, HomotopySchedule, KFunctional,
+    SmoothFunctional, SmoothOptions, SmoothReport,
 };
 pub use error::OptimError;
 pub use linalg::Preconditioner;

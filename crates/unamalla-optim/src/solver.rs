@@ -79,6 +79,32 @@ pub enum PointwiseMode {
     Components,
 }
 
+impl PointwiseMode {
+    /// The command-line name (`simultaneous`, `components`; UNAMALLA's "simultaneous" and
+    /// "by components" modes of Newton Point to Point, González Flores, UNAMALLA thesis,
+    /// §A.4.3 and App. B §B.5.2).
+    pub fn name(self) -> &'static str {
+        match self {
+            PointwiseMode::Simultaneous => "simultaneous",
+            PointwiseMode::Components => "components",
+        }
+    }
+}
+
+impl FromStr for PointwiseMode {
+    type Err = OptimError;
+    fn from_str(s: &str) -> Result<Self, OptimError> {
+        [PointwiseMode::Simultaneous, PointwiseMode::Components]
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| OptimError::UnknownName {
+                what: "pointwise mode",
+                name: s.to_string(),
+                expected: "simultaneous, components",
+            })
+    }
+}
+
 /// How truncated Newton forms Hessian-vector products.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum HessianMode {
@@ -239,7 +265,9 @@ impl SolverOptions {
             ..Default::default()
         }
     }
-    fn validate(&self) -> Result<(), OptimError> {
+    /// Checks the options (tolerances finite and ≥ 0, L-BFGS memory ≥ 1, ...); the solvers call
+    /// it first, front ends may call it to report a bad option before any work.
+    pub fn validate(&self) -> Result<(), OptimError> {
         let pos = |name, v: f64| {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
