@@ -75,6 +75,9 @@ pub enum BsplineError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A least-squares boundary fit is not well posed (too few samples, degenerate polyline).
+    #[error("boundary fit: {0}")]
+    Fit(String),
     /// The interior optimization failed on its input.
     #[error("interior control points: {0}")]
     Optimization(String),

@@ -46,6 +46,7 @@ pub mod certify;
 pub mod curve;
 pub mod error;
 pub mod export;
+pub mod fit;
 pub mod interior;
 pub mod knots;
 pub mod map;
@@ -61,6 +62,7 @@ pub use certify::{
 };
 pub use curve::BSplineCurve;
 pub use error::BsplineError;
+pub use fit::{fit_polyline, FitParameters, FitReport};
 pub use interior::{optimize_interior, InteriorOptions, InteriorReport};
 pub use knots::KnotVector;
 pub use map::{Degree, TensorMap};

@@ -393,6 +393,55 @@ impl BoundaryCurves {
     }
 }
 
+impl BoundaryCurves {
+    /// Option (b) of the boundary preparation: a counter-clockwise ring split at four corner
+    /// indices (as [`BoundaryCurves::from_ring`]), each side **fitted** by least squares
+    /// ([`crate::fit::fit_polyline`]: quadratic, uniform knots (23)/(24), end points fixed to
+    /// the corners; Piegl & Tiller 1997, §9.4.1) with `n` (south/north) or `m` (west/east)
+    /// control points. Returns the curves and the fit residuals of south, east, north, west.
+    pub fn fit_ring(
+        ring: &[DVec2],
+        corners: [usize; 4],
+        n: usize,
+        m: usize,
+        kind: crate::fit::FitParameters,
+    ) -> Result<(Self, [crate::fit::FitReport; 4]), BsplineError> {
+        // the sides as dense polylines: every ring vertex of the side is kept
+        let len = ring.len();
+        if corners.iter().any(|&c| c >= len) {
+            return Err(BsplineError::Fit(format!(
+                "corner indices {corners:?} out of range for a ring of {len} points"
+            )));
+        }
+        let arc = |a: usize, b: usize| -> Vec<DVec2> {
+            let mut v = vec![ring[a]];
+            let mut k = a;
+            while k != b {
+                k = (k + 1) % len;
+                v.push(ring[k]);
+            }
+            v
+        };
+        let (south, rs) = crate::fit::fit_polyline(&arc(corners[0], corners[1]), n, kind)?;
+        let (east, re) = crate::fit::fit_polyline(&arc(corners[1], corners[2]), m, kind)?;
+        let mut top = arc(corners[2], corners[3]);
+        top.reverse();
+        let (north, rn) = crate::fit::fit_polyline(&top, n, kind)?;
+        let mut left = arc(corners[3], corners[0]);
+        left.reverse();
+        let (west, rw) = crate::fit::fit_polyline(&left, m, kind)?;
+        Ok((
+            Self {
+                south,
+                east,
+                north,
+                west,
+            },
+            [rs, re, rn, rw],
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

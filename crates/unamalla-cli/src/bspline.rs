@@ -27,7 +27,7 @@ use anyhow::{bail, Context, Result};
 use serde_json::{json, Value};
 use unamalla_core::bspline::{
     certify_map, export, optimize_interior, BernsteinOutcome, BoundaryCurves, Certificates,
-    ControlNet, Degree, InteriorOptions, TensorMap,
+    ControlNet, Degree, FitParameters, InteriorOptions, TensorMap,
 };
 use unamalla_core::bspline_maps::{block_maps, BlockMapOptions};
 use unamalla_core::io;
@@ -50,6 +50,13 @@ pub struct BsplineArgs {
     /// counter-clockwise); default automatic.
     #[arg(long, value_parser = crate::parse_corners, conflicts_with = "blocks")]
     pub corners: Option<[usize; 4]>,
+    /// Boundary curves by a least-squares fit of each side (quadratic, uniform knots, ends at
+    /// the corners; `--net NxM` gives the control point counts) with `chord-length` or
+    /// `centripetal` sample parameters, instead of using the resampled sides directly as
+    /// control polygons. Ragged sides (e.g. texas) need it: the resampled control polygon
+    /// self-intersects.
+    #[arg(long, value_parser = ["chord-length", "centripetal"], conflicts_with = "blocks")]
+    pub fit: Option<String>,
     /// One map per block of the pipeline's block-structured mesh instead of one net.
     #[arg(long)]
     pub blocks: bool,
@@ -250,7 +257,21 @@ pub fn run(a: BsplineArgs) -> Result<()> {
             None => Corners::Auto,
         };
         let c = resolve_corners(&region, &corners, n, m)?;
-        let boundary = BoundaryCurves::from_ring(region.outer().points(), c, n, m)?;
+        let (boundary, fit_report) = match a.fit.as_deref() {
+            None => (
+                BoundaryCurves::from_ring(region.outer().points(), c, n, m)?,
+                None,
+            ),
+            Some(kind) => {
+                let kind = if kind == "centripetal" {
+                    FitParameters::Centripetal
+                } else {
+                    FitParameters::ChordLength
+                };
+                let (b, r) = BoundaryCurves::fit_ring(region.outer().points(), c, n, m, kind)?;
+                (b, Some((kind, r)))
+            }
+        };
         let mut net = ControlNet::from_boundary(&boundary)?;
         if !a.quiet {
             eprintln!("· {name}: {n}x{m} control net; optimizing the interior control points");
@@ -276,6 +297,7 @@ pub fn run(a: BsplineArgs) -> Result<()> {
             "degree": a.degree,
             "net": [n, m],
             "corners_ring_indices": c,
+            "boundary_fit": fit_report.map(|(k, r)| json!({"parameters": k, "south": r[0], "east": r[1], "north": r[2], "west": r[3]})),
             "samples": a.samples,
             "min_det_j": s.min,
             "min_det_j_at": [s.argmin.0, s.argmin.1],
