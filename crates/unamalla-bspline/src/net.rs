@@ -413,15 +413,7 @@ impl BoundaryCurves {
                 "corner indices {corners:?} out of range for a ring of {len} points"
             )));
         }
-        let arc = |a: usize, b: usize| -> Vec<DVec2> {
-            let mut v = vec![ring[a]];
-            let mut k = a;
-            while k != b {
-                k = (k + 1) % len;
-                v.push(ring[k]);
-            }
-            v
-        };
+        let arc = |a: usize, b: usize| unamalla_mesh::tfi::ring_arc(ring, a, b);
         let (south, rs) = crate::fit::fit_polyline(&arc(corners[0], corners[1]), n, kind)?;
         let (east, re) = crate::fit::fit_polyline(&arc(corners[1], corners[2]), m, kind)?;
         let mut top = arc(corners[2], corners[3]);

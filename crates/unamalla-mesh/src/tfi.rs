@@ -171,15 +171,7 @@ pub fn sides_from_ring(
             "corners {corners:?} must be distinct and in counter-clockwise order along the ring"
         )));
     }
-    let arc = |a: usize, b: usize| -> Vec<DVec2> {
-        let mut v = vec![ring[a]];
-        let mut k = a;
-        while k != b {
-            k = (k + 1) % len;
-            v.push(ring[k]);
-        }
-        v
-    };
+    let arc = |a: usize, b: usize| ring_arc(ring, a, b);
     let bottom = resample_arc_length(&arc(corners[0], corners[1]), m)?;
     let right = resample_arc_length(&arc(corners[1], corners[2]), n)?;
     let mut top = resample_arc_length(&arc(corners[2], corners[3]), m)?;
@@ -375,4 +367,19 @@ pub fn tfi3(faces: &HexFaces) -> Result<StructuredGrid3, MeshError> {
         }
         r
     })
+}
+
+/// The vertices of `ring` from index `a` to index `b` inclusive, following the ring forward
+/// (cyclically): the polyline of one block side between two corners. `a == b` gives `[ring[a]]`.
+///
+/// Panics if `a` or `b` is not an index of `ring` (callers check corner indices first).
+pub fn ring_arc(ring: &[DVec2], a: usize, b: usize) -> Vec<DVec2> {
+    let len = ring.len();
+    let mut v = vec![ring[a]];
+    let mut k = a;
+    while k != b {
+        k = (k + 1) % len;
+        v.push(ring[k]);
+    }
+    v
 }
