@@ -270,10 +270,17 @@ fn check_replaceable(target: &Path) -> Result<(), OutputError> {
     if target.join(MARKER).is_file() {
         return Ok(());
     }
-    let mut entries =
-        fs::read_dir(target).map_err(io_err(target, "reading the output directory"))?;
+    let mut entries = match fs::read_dir(target) {
+        Ok(entries) => entries,
+        // moved aside by a concurrent run's commit since the metadata above (that run's set,
+        // which had the marker): the target is absent now
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(io_err(target, "reading the output directory")(e)),
+    };
     match entries.next() {
         None => Ok(()),
+        // a concurrent run's set (with its marker) moved in since the marker test above
+        Some(_) if target.join(MARKER).is_file() => Ok(()),
         Some(e) => Err(OutputError::Foreign {
             path: target.to_path_buf(),
             example: e
