@@ -154,9 +154,6 @@ struct Candidate {
     /// Signed (shoelace) area of the piece, traversed in the ring's direction: positive for
     /// region material (the region lies left of every boundary edge).
     signed_area: f64,
-    /// The piece as a chain of ring vertices (first vertex, number of ring edges) closed by
-    /// the chord's end on an edge.
-    piece: (usize, usize, DVec2),
 }
 
 impl Candidate {
@@ -364,37 +361,27 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
                 let s_b = (j + 1) % n;
                 let m_b = (i + n - s_b) % n;
                 let (sa_b, per_b) = chains.piece(s_b, m_b, q);
-                let cand = if sa_f.abs() <= sa_b.abs() {
-                    Candidate {
-                        ring: r,
-                        keep: i,
+                // the smaller piece: (signed area, perimeter, first chain vertex, chain edges,
+                // kept vertex before the removed run, removed vertices, chord)
+                let (signed, perimeter, start, edges, keep, removed, chord) =
+                    if sa_f.abs() <= sa_b.abs() {
                         // q = p_j: p_j stays (one fewer removed, nothing inserted)
-                        removed: if q == a { m_f - 1 } else { m_f },
-                        insert: (q != a && q != b).then_some(q),
-                        tip: None,
-                        chord: (p, q),
-                        area: sa_f.abs(),
-                        signed_area: sa_f,
-                        piece: (i, m_f, q),
-                    }
-                    .with_perimeter(per_f)
-                } else {
-                    Candidate {
-                        ring: r,
+                        let removed = if q == a { m_f - 1 } else { m_f };
+                        (sa_f, per_f, i, m_f, i, removed, (p, q))
+                    } else {
                         // q = p_{j+1}: p_{j+1} stays (the run starts after it)
-                        keep: if q == b { s_b } else { j },
-                        removed: if q == b { m_b - 1 } else { m_b },
-                        insert: (q != a && q != b).then_some(q),
-                        tip: None,
-                        chord: (q, p),
-                        area: sa_b.abs(),
-                        signed_area: sa_b,
-                        piece: (s_b, m_b, q),
-                    }
-                    .with_perimeter(per_b)
-                };
-                let Some((cand, perimeter)) = cand else {
-                    continue;
+                        let (keep, removed) = if q == b { (s_b, m_b - 1) } else { (j, m_b) };
+                        (sa_b, per_b, s_b, m_b, keep, removed, (q, p))
+                    };
+                let cand = Candidate {
+                    ring: r,
+                    keep,
+                    removed,
+                    insert: (q != a && q != b).then_some(q),
+                    tip: None,
+                    chord,
+                    area: signed.abs(),
+                    signed_area: signed,
                 };
                 let kept = n - cand.removed + usize::from(cand.insert.is_some());
                 if cand.removed == 0 || kept < 4 || cand.area.is_nan() || cand.area <= 0.0 {
@@ -409,7 +396,12 @@ fn candidates(rings: &[Vec<DVec2>], index: &SegmentIndex, opts: &NeckOptions) ->
                     continue;
                 }
                 // condition 3
-                if !chord_clear(index, r, n, p, q, i, j) || piece_contains_ring(rings, r, &cand) {
+                let piece = (0..=edges)
+                    .map(|k| ring[(start + k) % n])
+                    .chain([q])
+                    .collect();
+                let incident = [i, (i + n - 1) % n, j];
+                if !chord_clear(index, r, &incident, p, q) || encloses_other_ring(rings, r, piece) {
                     continue;
                 }
                 best = Some(cand);
@@ -461,19 +453,9 @@ fn tip_candidate(
         return None;
     }
     let prev = (i + n - 1) % n;
-    let blocked = index.candidates(u, v).any(|e| {
-        if e.ring == r && (e.edge == i || e.edge == prev) {
-            return false;
-        }
-        let (s, t) = index.edge(e);
-        open_segment_hits(u, v, s, t)
-    });
-    let tri = Polygon::from_points_unchecked(vec![u, p, v]);
-    let encloses = rings
-        .iter()
-        .enumerate()
-        .any(|(k, other)| k != r && tri.locate(other[0]) == Location::Inside);
-    (!blocked && !encloses).then_some(Candidate {
+    let clear =
+        chord_clear(index, r, &[i, prev], u, v) && !encloses_other_ring(rings, r, vec![u, p, v]);
+    clear.then_some(Candidate {
         ring: r,
         keep: prev,
         removed: 1,
@@ -482,14 +464,7 @@ fn tip_candidate(
         chord: (u, v),
         area: signed.abs(),
         signed_area: signed,
-        piece: (i, 0, u), // not used for a tip (its triangle is checked above)
     })
-}
-
-impl Candidate {
-    fn with_perimeter(self, perimeter: f64) -> Option<(Candidate, f64)> {
-        (perimeter > 0.0 && self.area.is_finite()).then_some((self, perimeter))
-    }
 }
 
 /// The closest point of segment `ab` to `p` (exactly `a` or `b` at the ends).
@@ -510,33 +485,21 @@ fn closest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> DVec2 {
     }
 }
 
-/// Condition 3, first half: the chord `p q` meets no boundary edge except the edges incident to
-/// `p_i` (ring `r`, `n` vertices) and the edge `j` that holds `q`.
-fn chord_clear(
-    index: &SegmentIndex,
-    r: usize,
-    n: usize,
-    p: DVec2,
-    q: DVec2,
-    i: usize,
-    j: usize,
-) -> bool {
-    !index.candidates(p, q).any(|e| {
-        if e.ring == r && (e.edge == i || e.edge == (i + n - 1) % n || e.edge == j) {
+/// Condition 3, first half: the chord `u v` meets no boundary edge except the edges `skip` of
+/// ring `r` (those incident to the chord's ends).
+fn chord_clear(index: &SegmentIndex, r: usize, skip: &[usize], u: DVec2, v: DVec2) -> bool {
+    !index.candidates(u, v).any(|e| {
+        if e.ring == r && skip.contains(&e.edge) {
             return false;
         }
         let (a, b) = index.edge(e);
-        open_segment_hits(p, q, a, b)
+        open_segment_hits(u, v, a, b)
     })
 }
 
-/// Condition 3, second half: some other ring lies inside the piece.
-fn piece_contains_ring(rings: &[Vec<DVec2>], r: usize, cand: &Candidate) -> bool {
-    let ring = &rings[r];
-    let n = ring.len();
-    let (start, edges, x) = cand.piece;
-    let mut piece: Vec<DVec2> = (0..=edges).map(|k| ring[(start + k) % n]).collect();
-    piece.push(x);
+/// Condition 3, second half: some ring other than `r` lies inside the piece (the rings are
+/// disjoint and the chord crosses none, so one vertex of each tells).
+fn encloses_other_ring(rings: &[Vec<DVec2>], r: usize, piece: Vec<DVec2>) -> bool {
     let poly = Polygon::from_points_unchecked(piece);
     rings
         .iter()
