@@ -59,6 +59,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde::Serialize;
 use unamalla_compat_ilp as ilp;
 use unamalla_contour::{remove_features_below, simplify_region, SimplifyOptions};
@@ -1067,14 +1068,28 @@ pub fn choose_layout(
 ) -> Result<(Decomposition, LayoutChoice), CoreError> {
     // (name, layout cuts for a chord layout, decomposition)
     type Cand = (&'static str, Option<Vec<(DVec2, DVec2)>>, Decomposition);
-    let mut cands: Vec<Cand> = Vec::new();
-    let conc = decompose(
-        region,
-        &DecomposeOptions {
-            layout: Layout::Concavity,
-            ..opts.clone()
+    // the candidate layouts are independent: built (and predicted below) in parallel, the
+    // results kept in the order of the list, so the choice does not depend on the threads
+    let conc_opts = DecomposeOptions {
+        layout: Layout::Concavity,
+        ..opts.clone()
+    };
+    let (conc, chord_layouts) = rayon::join(
+        || decompose(region, &conc_opts),
+        || {
+            LAYOUT_ASPECTS
+                .par_iter()
+                .map(|&(name, aspect)| {
+                    let o = DecomposeOptions {
+                        chord_aspect: aspect,
+                        ..opts.clone()
+                    };
+                    (name, chord_layout_cuts(region, &o))
+                })
+                .collect::<Vec<_>>()
         },
     );
+    let mut cands: Vec<Cand> = Vec::new();
     let conc_err = match conc {
         Ok(d) => {
             cands.push(("concavity", None, d));
@@ -1082,22 +1097,22 @@ pub fn choose_layout(
         }
         Err(e) => Some(e),
     };
-    for (name, aspect) in LAYOUT_ASPECTS {
-        let o = DecomposeOptions {
-            chord_aspect: aspect,
-            ..opts.clone()
-        };
-        if let Ok((cuts, d)) = chord_layout_cuts(region, &o) {
+    for (name, built) in chord_layouts {
+        if let Ok((cuts, d)) = built {
             if !cands.iter().any(|(_, _, c)| *c == d) {
                 cands.push((name, Some(cuts), d));
             }
         }
     }
+    let predictions: Vec<_> = cands
+        .par_iter()
+        .map(|(_, _, d)| crate::predict::predict_mesh(d, size))
+        .collect();
     // key: fewer rule breaks, then the predicted share, then fewer blocks
     let mut best: Option<((usize, f64, usize), usize, crate::predict::Prediction)> = None;
     let mut scores = Vec::new();
-    for (k, (name, _, d)) in cands.iter().enumerate() {
-        let Ok(p) = crate::predict::predict_mesh(d, size) else {
+    for (k, ((name, _, d), pred)) in cands.iter().zip(predictions).enumerate() {
+        let Ok(p) = pred else {
             continue;
         };
         scores.push((name.to_string(), 100.0 * p.good_share));

@@ -1,7 +1,10 @@
 //! The automatic decomposition: Algorithm 1 driving Algorithms 2–4 (seed 000 digest §3.2),
 //! with the cut score documented in the crate root, and the assembly of the final blocks.
 
+use std::collections::HashMap;
 use std::f64::consts::PI;
+
+use rayon::prelude::*;
 
 use unamalla_mesh::{DVec2, Region};
 
@@ -176,19 +179,48 @@ pub fn chord_layout_cuts(
     // up to ARM_ROUNDS times: blocks that still keep an arm (a part ≥ ARM_SCORE chord widths
     // beyond a chord between two boundary points) get that chord as one more layout cut
     let mut d = None;
+    // the arm chord of a block depends only on its ring and which edges are region boundary;
+    // most blocks come back unchanged from one round to the next, so each is searched once
+    // (the search triangulates the block, the costliest step of the layout)
+    let mut searched: HashMap<Vec<u64>, Option<(DVec2, DVec2)>> = HashMap::new();
     for round in 0..=ARM_ROUNDS {
         let dec = layout_from_cuts(region, opts, &cuts)?;
         let extra: Vec<(DVec2, DVec2)> = if round < ARM_ROUNDS {
-            dec.blocks
+            let keyed: Vec<(Vec<u64>, Vec<bool>)> = dec
+                .blocks
                 .iter()
-                .filter_map(|blk| {
+                .map(|blk| {
                     let on: Vec<bool> = blk
                         .edges
                         .iter()
                         .map(|e| matches!(e, EdgeKind::Boundary { .. }))
                         .collect();
-                    crate::chords::arm_chord(&blk.ring, &on, ARM_SCORE, 0.0)
+                    let key = blk
+                        .ring
+                        .iter()
+                        .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
+                        .chain(on.iter().map(|&b| b as u64))
+                        .collect();
+                    (key, on)
                 })
+                .collect();
+            // blocks not searched before, in block order; searched in parallel (the results
+            // are collected in that order, so the layout does not depend on the threads)
+            let todo: Vec<usize> = (0..keyed.len())
+                .filter(|&b| !searched.contains_key(&keyed[b].0))
+                .collect();
+            let found: Vec<Option<(DVec2, DVec2)>> = todo
+                .par_iter()
+                .map(|&b| {
+                    crate::chords::arm_chord(&dec.blocks[b].ring, &keyed[b].1, ARM_SCORE, 0.0)
+                })
+                .collect();
+            for (&b, f) in todo.iter().zip(found) {
+                searched.insert(keyed[b].0.clone(), f);
+            }
+            keyed
+                .iter()
+                .filter_map(|(key, _)| searched.get(key).copied().flatten())
                 .collect()
         } else {
             Vec::new()

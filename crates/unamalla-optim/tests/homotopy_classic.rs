@@ -12,6 +12,7 @@ use unamalla_optim::drivers::{
 };
 use unamalla_optim::fixtures::{ivanenko, perturbed};
 use unamalla_optim::monitor::{NullObserver, Session};
+use unamalla_optim::Status;
 
 #[test]
 fn schedules_by_hand() {
@@ -222,4 +223,63 @@ fn ivanenko_functional_untangles_the_folded_ivanenko_grid_to_eps_convexity() {
     assert_eq!(r2.iterations(), 0);
     assert_eq!(g.nodes(), before.nodes());
     assert!(SmoothFunctional::Ivanenko.with_sigma(0.5).is_err());
+}
+
+#[test]
+fn stopping_at_the_target_bound_ends_a_homotopy_the_thesis_loop_cannot_end() {
+    // 3 × 3 nodes on the unit square, one free node p; the bottom middle node sits at (δ, 0).
+    // Corner triangles (doubled areas) of p's cells that bound α₋: at (δ, 0) in the lower
+    // left cell δ·p_y, at (0.5, 1) in the upper left cell 0.5·(1 − p_y). So
+    // α₋ ≤ max_p min(δ·p_y, 0.5·(1 − p_y)) = 0.5δ/(0.5 + δ), with ᾱ = 4·area/16 = 0.25:
+    // for δ = 0.004, α₋/ᾱ ≤ 0.01587 — above the target 0.01 of k* = −0.01, below the
+    // 0.02/1.0015 that the thesis's exit k̃ = −1.0015·α₋ + 0.01·ᾱ ≤ k*·ᾱ needs.
+    let delta = 0.004;
+    let xs = [0.0, 0.5, 1.0];
+    let g = StructuredGrid2::from_fn(3, 3, |i, j| match (i, j) {
+        (1, 0) => DVec2::new(delta, 0.0),
+        (1, 1) => DVec2::new(0.5, 0.5),
+        _ => DVec2::new(xs[i], xs[j]),
+    })
+    .unwrap();
+    let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
+    let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Kernel2::Length);
+    let bound = 0.5 * delta / (0.5 + delta) / 0.25;
+    let run = |stop_at_target: bool| {
+        let mut x = topo.initial_x();
+        let mut obs = NullObserver;
+        let mut s = Session::new(&probe, &x, &mut obs);
+        let opts = AdaptiveKOptions {
+            classic: false,
+            max_updates: 40,
+            stop_at_target,
+            ..Default::default()
+        };
+        let r = adaptive_k(&topo, &mut x, &opts, &mut s).unwrap();
+        // α₋ over the triangles with a free vertex (the corner (0, 0) of the lower left cell,
+        // 0.5δ, is boundary data)
+        assert!((r.alpha_bar - 0.25).abs() < 1e-12);
+        assert!(
+            (r.initial_alfamin - 0.5 * delta).abs() < 1e-12,
+            "the start: α₋ = δ·p_y = 0.5δ"
+        );
+        let q = r.alfamin / r.alpha_bar;
+        (r, q)
+    };
+    let (thesis, q_t) = run(false);
+    let (target, q_s) = run(true);
+    assert!(q_t <= bound + 1e-12 && q_s <= bound + 1e-12);
+    // the thesis's loop cannot reach its exit: it stops without "the homotopic step is ok"
+    assert!(
+        !thesis.messages.contains(&Status::HomotopicOk),
+        "{:?}",
+        thesis.messages
+    );
+    // at the target: convex with α₋ > 0.01ᾱ, ended by the homotopy itself
+    assert!(target.convex && q_s > 0.01, "α₋/ᾱ = {q_s}");
+    assert!(
+        target.messages.contains(&Status::HomotopicOk),
+        "{:?}",
+        target.messages
+    );
+    assert!(target.iter_homotopic < thesis.iter_homotopic);
 }
