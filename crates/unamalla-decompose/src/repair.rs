@@ -123,6 +123,63 @@ fn ring_key(r: &Ring) -> DVec2 {
     r.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p)
 }
 
+/// A fingerprint of block slot `k`, the blocks across its cuts and the blocks across theirs
+/// (rings, tags and the liveness of those cuts): what the three repair steps of
+/// [`Builder::repair_pass`] read. `DefaultHasher::new()` has fixed keys, so the value is the
+/// same in every run.
+fn neighbourhood_fingerprint(slot: &[Option<Ring>], k: usize, alive: &[bool]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    let across = |r: &Ring| -> Vec<usize> {
+        r.tags
+            .iter()
+            .filter_map(|t| match *t {
+                Tag::Cut(c) => Some(c),
+                _ => None,
+            })
+            .flat_map(|c| {
+                slot.iter().enumerate().filter_map(move |(j, o)| {
+                    o.as_ref()
+                        .filter(|o| o.tags.contains(&Tag::Cut(c)))
+                        .map(|_| j)
+                })
+            })
+            .collect()
+    };
+    let mut seen = vec![k];
+    let mut frontier = vec![k];
+    for _ in 0..2 {
+        let mut next = Vec::new();
+        for &s in &frontier {
+            if let Some(r) = slot[s].as_ref() {
+                for j in across(r) {
+                    if !seen.contains(&j) {
+                        seen.push(j);
+                        next.push(j);
+                    }
+                }
+            }
+        }
+        frontier = next;
+    }
+    for &s in &seen {
+        s.hash(&mut h);
+        if let Some(r) = slot[s].as_ref() {
+            for (p, t) in r.pts.iter().zip(&r.tags) {
+                p.x.to_bits().hash(&mut h);
+                p.y.to_bits().hash(&mut h);
+                match *t {
+                    Tag::Cut(c) => {
+                        (1u8, c, alive.get(c).copied().unwrap_or(false)).hash(&mut h);
+                    }
+                    Tag::Boundary(b) => (0u8, b).hash(&mut h),
+                }
+            }
+        }
+    }
+    h.finish()
+}
+
 /// A split candidate: score, the two children (new cut tagged [`TMP_CUT`]), cut endpoints.
 type Split = (f64, Ring, Ring, (DVec2, DVec2));
 
@@ -736,6 +793,10 @@ impl Builder<'_> {
         // a repair changes the neighbours of blocks already passed over: sweep again while
         // the last sweep changed something (and the budget lasts)
         let mut changed = false;
+        // the neighbourhood fingerprint of each block whose repair failed: the search depends
+        // only on the block, its neighbours and theirs (and the live cuts between them), so
+        // while those are unchanged a later sweep would fail again on the same candidates
+        let mut failed: Vec<Option<u64>> = Vec::new();
         while budget > 0 {
             if k >= slot.len() {
                 if !changed {
@@ -748,6 +809,11 @@ impl Builder<'_> {
                 continue;
             };
             if !self.needs_repair(&r) {
+                k += 1;
+                continue;
+            }
+            let print = neighbourhood_fingerprint(&slot, k, &alive);
+            if failed.get(k).copied().flatten() == Some(print) {
                 k += 1;
                 continue;
             }
@@ -776,7 +842,13 @@ impl Builder<'_> {
                     self.apply_resplit(&mut slot, &mut owner, &mut alive, k, t);
                     changed = true;
                 }
-                None => k += 1,
+                None => {
+                    if failed.len() <= k {
+                        failed.resize(k + 1, None);
+                    }
+                    failed[k] = Some(print);
+                    k += 1;
+                }
             }
         }
         self.joint_pass(&mut slot, &mut owner, &mut alive);
