@@ -1188,6 +1188,9 @@ pub fn choose_layout(
     }
 }
 
+/// The split chords found by [`resplit`], by (block ring key, number of layout cuts).
+type ChordCache = std::collections::HashMap<(Vec<u64>, usize), Option<(DVec2, DVec2)>>;
+
 /// The predicted-quality re-split of a chord layout ([`choose_layout`]): returns the
 /// decomposition, its prediction, the cuts added and the candidates tried.
 fn resplit(
@@ -1208,6 +1211,7 @@ fn resplit(
     };
     let min_area = RESPLIT_CELLS * h2;
     let mut tried: Vec<(DVec2, DVec2)> = Vec::new();
+    let mut searched: ChordCache = ChordCache::new();
     let mut added = 0;
     while tried.len() < RESPLIT_EVALS && d.blocks.len() <= RESPLIT_MAX_BLOCKS {
         let mut order: Vec<(f64, usize)> = (0..d.blocks.len().min(p.blocks.len()))
@@ -1216,8 +1220,13 @@ fn resplit(
             .collect();
         order.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
         let cand = order.iter().find_map(|&(_, b)| {
-            split_chord(region, &d, b, &cuts, RESPLIT_SCORE, min_area)
-                .filter(|c| !tried.contains(c))
+            // a block's chord depends on its ring and on the layout cuts, which only grow
+            // (by an accepted cut): each (ring, layout) is searched once
+            let key = (d.blocks[b].ring_key(), cuts.len());
+            let chord = *searched
+                .entry(key)
+                .or_insert_with(|| split_chord(region, &d, b, &cuts, RESPLIT_SCORE, min_area));
+            chord.filter(|c| !tried.contains(c))
         });
         let Some(c) = cand else {
             break;

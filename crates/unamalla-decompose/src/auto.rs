@@ -195,12 +195,8 @@ pub fn chord_layout_cuts(
                         .iter()
                         .map(|e| matches!(e, EdgeKind::Boundary { .. }))
                         .collect();
-                    let key = blk
-                        .ring
-                        .iter()
-                        .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
-                        .chain(on.iter().map(|&b| b as u64))
-                        .collect();
+                    let mut key = blk.ring_key();
+                    key.extend(on.iter().map(|&b| b as u64));
                     (key, on)
                 })
                 .collect();

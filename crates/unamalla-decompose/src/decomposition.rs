@@ -123,6 +123,16 @@ pub struct Decomposition {
 }
 
 impl Block {
+    /// The exact bit patterns of the ring's coordinates, `[x₀, y₀, x₁, …]`: a key under which
+    /// results that depend only on the block's geometry can be cached (two blocks have equal
+    /// keys exactly when their rings are equal, starting at the same vertex).
+    pub fn ring_key(&self) -> Vec<u64> {
+        self.ring
+            .iter()
+            .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
+            .collect()
+    }
+
     /// The four sides (bottom, right, top, left), each split into its curves Q_j: one per cut
     /// edge, one per maximal run of boundary edges of one region ring.
     pub fn side_curves(&self) -> [Vec<SideCurve>; 4] {
