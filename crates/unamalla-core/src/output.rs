@@ -12,9 +12,11 @@
 //!   `.<name>.unamalla-old-…`) and removed after the new set is in place. Dropping an
 //!   uncommitted `OutputDir` (an error, a panic) removes the staging directory, so a failed run
 //!   leaves the target exactly as it was. Two concurrent runs each have their own staging
-//!   directory; whichever commits last wins, and the target always holds exactly one run's
-//!   files. After `kill -9` the target is intact too (old set or new set); the orphaned
-//!   staging directory of a dead process is removed by the next run into the same target.
+//!   directory; their final renames are serialized by an exclusive lock on the parent
+//!   directory ([`std::fs::File::lock`]), so whichever commits last wins, and the target
+//!   always holds exactly one run's files. After `kill -9` the target is intact too (old set
+//!   or new set); the orphaned staging directory of a dead process is removed by the next run
+//!   into the same target.
 //!   An existing target directory is only replaced when it is empty or holds a previous
 //!   output (the marker file [`MARKER`] written by every commit); a directory with other
 //!   files (`-o .`, `-o ~`) is refused with [`OutputError::Foreign`], never deleted.
@@ -208,8 +210,12 @@ impl OutputDir {
         let text: String = files.iter().map(|f| format!("{f}\n")).collect();
         fs::write(&marker, text).map_err(io_err(&marker, "writing the marker"))?;
         sync_tree(&self.staging);
-        // Concurrent commits can re-create the target between moving it aside and moving the
-        // staging directory in; retry a few times (each round moves one run's set aside).
+        // commits into one parent directory are serialized by an exclusive lock on it, held
+        // until this function returns (see `lock_dir`)
+        let _lock = lock_dir(&self.parent);
+        // without the lock (a platform or file system without directory locks), concurrent
+        // commits can re-create the target between moving it aside and moving the staging
+        // directory in; retry a few times (each round moves one run's set aside)
         let mut last: Option<io::Error> = None;
         for _ in 0..16 {
             check_replaceable(&self.target)?;
@@ -255,6 +261,19 @@ impl Drop for OutputDir {
             let _ = fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// An exclusive advisory lock on directory `dir` (`flock` on Linux, through
+/// [`std::fs::File::lock`]), released when the returned file is dropped — also when the
+/// process dies, so a `kill -9` leaves no stale lock. Two commits into one directory then
+/// cannot interleave their "move the old set aside, move the new set in" steps: each finds the
+/// target as the previous commit left it. Locking the directory itself leaves no lock file
+/// behind. `None` where a directory cannot be opened or locked (e.g. Windows); the commit then
+/// falls back to its retry loop.
+fn lock_dir(dir: &Path) -> Option<fs::File> {
+    let f = fs::File::open(dir).ok()?;
+    f.lock().ok()?;
+    Some(f)
 }
 
 /// The target may be replaced: absent, or an empty directory, or a directory with the marker.
