@@ -97,7 +97,7 @@ impl Problem for Variant {
     }
     fn hessian(&self, x: &[f64], h: &mut Csr) {
         let n = self.calls.fetch_add(1, Ordering::Relaxed);
-        if n % self.every != 0 {
+        if !n.is_multiple_of(self.every) {
             return; // keep the previous values (lagged Hessian)
         }
         let t = Instant::now();

@@ -139,7 +139,7 @@ impl Multigrid {
     /// Builds the hierarchy of the symmetric matrix `a` whose unknowns are node blocks of size
     /// `dim` (`a.nrows` must be a multiple of `dim`; otherwise `dim = 1` is used).
     pub fn build(a: &Csr, dim: usize, opts: &MultigridOptions) -> Self {
-        let dim = if dim == 0 || a.nrows % dim != 0 {
+        let dim = if dim == 0 || !a.nrows.is_multiple_of(dim) {
             1
         } else {
             dim

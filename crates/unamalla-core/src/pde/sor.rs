@@ -129,7 +129,7 @@ pub(crate) fn solve(
         let diverging = !maxd.is_finite() || !umax.is_finite() || maxd > 1e12 * f.max(1.0);
         let stalled = adaptive
             && history.len() >= 30
-            && history.len() % 10 == 0
+            && history.len().is_multiple_of(10)
             && history[history.len() - 1] >= history[history.len() - 11];
         if diverging || stalled {
             if let Some((w0, mu0, u0)) = fallback.take() {
@@ -161,7 +161,7 @@ pub(crate) fn solve(
             // windows of ≥ 30 sweeps since the last change: near the optimum the SOR matrix
             // has 2 × 2 Jordan blocks, whose transient k·λᵏ would inflate a short-window ratio
             let h = history.len();
-            if h >= 30 && h % 10 == 0 {
+            if h >= 30 && h.is_multiple_of(10) {
                 let r = (history[h - 1] / history[h - 11]).powf(0.1);
                 if r < 1.0 && r > (w - 1.0).max(0.0).powf(HY_F) {
                     let mu_hat = (r + w - 1.0) / (w * r.sqrt());
