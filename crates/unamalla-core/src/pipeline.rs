@@ -1188,7 +1188,7 @@ pub fn choose_layout(
     }
 }
 
-/// The split chords found by [`resplit`], by (block ring key, number of layout cuts).
+/// The split chords found by [`resplit`], by (block geometry key, number of layout cuts).
 type ChordCache = std::collections::HashMap<(Vec<u64>, usize), Option<(DVec2, DVec2)>>;
 
 /// The predicted-quality re-split of a chord layout ([`choose_layout`]): returns the
@@ -1222,7 +1222,7 @@ fn resplit(
         let cand = order.iter().find_map(|&(_, b)| {
             // a block's chord depends on its ring and on the layout cuts, which only grow
             // (by an accepted cut): each (ring, layout) is searched once
-            let key = (d.blocks[b].ring_key(), cuts.len());
+            let key = (d.blocks[b].geometry_key(), cuts.len());
             let chord = *searched
                 .entry(key)
                 .or_insert_with(|| split_chord(region, &d, b, &cuts, RESPLIT_SCORE, min_area));

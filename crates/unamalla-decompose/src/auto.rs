@@ -195,7 +195,7 @@ pub fn chord_layout_cuts(
                         .iter()
                         .map(|e| matches!(e, EdgeKind::Boundary { .. }))
                         .collect();
-                    let mut key = blk.ring_key();
+                    let mut key = blk.geometry_key();
                     key.extend(on.iter().map(|&b| b as u64));
                     (key, on)
                 })

@@ -126,7 +126,7 @@ impl Block {
     /// The exact bit patterns of the ring's coordinates, `[x₀, y₀, x₁, …]`: a key under which
     /// results that depend only on the block's geometry can be cached (two blocks have equal
     /// keys exactly when their rings are equal, starting at the same vertex).
-    pub fn ring_key(&self) -> Vec<u64> {
+    pub fn geometry_key(&self) -> Vec<u64> {
         self.ring
             .iter()
             .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])

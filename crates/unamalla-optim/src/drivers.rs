@@ -531,8 +531,9 @@ fn length_presmooth(
 /// [`TARGET_STALL_UPDATES`] updates. The update `k̃` (4.35) is a function of `α₋` alone, so once
 /// `α₋` is stationary every further update poses the same problem again and only converges it
 /// further; while `α₋` rises, the homotopy is still smoothing the mesh (measured on the gulf of
-/// Mexico at 20,000 cells: leaving at the first iterate past the bound ended 3 points of
-/// μ ≥ 0.8 lower than leaving at the stall).
+/// Mexico at 20,000 cells: leaving at the first iterate past the bound gave μ ≥ 0.8 on
+/// 90.6 % of the cells, leaving at the stall 92.2 %, the thesis's loop run to its update cap
+/// 93.6 % in about twice the time).
 pub const TARGET_STALL_UPDATES: usize = 4;
 
 /// The rise of `α₋/ᾱ` over [`TARGET_STALL_UPDATES`] updates below which the homotopy counts as
