@@ -466,19 +466,12 @@ fn fast_cases() -> Vec<Case> {
         hostile("l-1e6.geojson"),
         &["--cells", "300"],
     ));
-    // a decomposition limitation at 10⁹ offsets (docs/reliability.md): a clear input error
-    v.push(case(
+    // an L of 2 units at (10⁹, 10⁹): the cut test and the area check work in the coordinates'
+    // precision (docs/reliability.md)
+    v.push(mesh_ok(
         "mesh L offset 1e9",
-        &[
-            "mesh",
-            &p(hostile("l-offset-1e9.geojson")),
-            "--cells",
-            "300",
-            "-o",
-            "{out}",
-        ],
-        1,
-        &["cut 0"],
+        hostile("l-offset-1e9.geojson"),
+        &["--cells", "300"],
     ));
     v.push(mesh_ok(
         "mesh 1e-7 spike (simplified)",
@@ -1370,8 +1363,9 @@ fn issue_examples_and_hang_cases() {
             1,
             &["meshable gap", "drop --no-simplify"],
         ),
-        // measured 2026-12-02 after the layout merges: decomposed, but 5 folded cells among the
-        // 0.4-wide holes at the cell size 0.63 (docs/reliability.md): refused, exit 3
+        // decomposed, but 3 folded cells among the 0.4-wide holes at the cell size 0.63
+        // (docs/reliability.md): refused, and the message names a hole narrower than a cell,
+        // the count of such holes and the two remedies (exit 1: an input the size cannot mesh)
         case(
             "500 holes at 20000 cells",
             &[
@@ -1383,23 +1377,21 @@ fn issue_examples_and_hang_cases() {
                 "{out}",
                 "--quiet",
             ],
-            3,
-            &["not convex", "nothing written"],
-        ),
-        // holes 1e-6 apart at 2000 cells: folded cells in the gap, refused (exit 3)
-        case(
-            "near-touching holes",
+            1,
             &[
-                "mesh",
-                &p(hostile("near-touching-holes.geojson")),
-                "--cells",
-                "2000",
-                "-o",
-                "{out}",
-                "--quiet",
+                "nothing written",
+                "is narrower than the cell size",
+                "499 other hole(s)",
+                "--min-hole-area",
+                "not convex",
             ],
-            3,
-            &["not convex", "nothing written"],
+        ),
+        // holes 1e-6 apart at 2000 cells: meshed since the layout merges (thin convex cells in
+        // the gap; checked like every accepted case)
+        mesh_ok(
+            "near-touching holes",
+            hostile("near-touching-holes.geojson"),
+            &["--cells", "2000"],
         ),
         case(
             "hex --perturb 1e6",

@@ -24,6 +24,9 @@
 //! * `final02` / `final03` / `final05` — the default options with the final σ = 0.2, 0.3 or
 //!   0.5 instead of 0.1 (no coarse level).
 //!
+//! With `UNAMALLA_STUDY_TRACE=1` every observer call prints a line `trace N PHASE F α₋/ᾱ μ-share
+//! non-convex elapsed` on stderr.
+//!
 //! With `UNAMALLA_STUDY_PNG=DIR` every run also writes its μ band picture
 //! (`unamalla_core::render::quality_png`, 800 px) to `DIR/REGION-CANDIDATE.png`.
 //!
@@ -126,8 +129,20 @@ fn main() {
         };
         for (cand, opts, levels) in candidates() {
             let mut iterations = 0usize;
-            let mut count = |_: &Monitor| {
+            let trace = std::env::var_os("UNAMALLA_STUDY_TRACE").is_some();
+            let mut count = |m: &Monitor| {
                 iterations += 1;
+                if trace {
+                    eprintln!(
+                        "trace {iterations} {:?} F {:.6e} a {:.4e} mu {:?} inocon {} t {:.2}",
+                        m.phase,
+                        m.f,
+                        m.alfamin_rel(),
+                        m.mu,
+                        m.inocon,
+                        m.elapsed.as_secs_f64()
+                    );
+                }
                 Control::Continue
             };
             let cpu0 = cpu_seconds();

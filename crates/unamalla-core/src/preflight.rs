@@ -127,6 +127,9 @@ pub enum PreflightError {
         /// `MIN_GAP_FRACTION · h`.
         need: f64,
     },
+    /// A failure next to a hole narrower than the cell size ([`small_hole`]).
+    #[error("{0}")]
+    SmallHole(Box<SmallHole>),
     /// A failure explained by a too-narrow gap between rings.
     #[error(
         "{} is {gap:.3e} from {}, below the meshable gap of {need:.3e} ({MIN_GAP_FRACTION} × the cell size {h:.3e}); \
@@ -148,6 +151,119 @@ pub enum PreflightError {
         /// The stage's own message.
         detail: String,
     },
+}
+
+/// The verification's failing cells next to a hole narrower than the cell size (see
+/// [`explain_guarantee`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "hole {hole} ({width:.3e} across, centred at ({:.6e}, {:.6e})) is narrower than the cell size \
+     {h:.3e}: {cells} of the listed failing cells lie within a cell size of it{}; drop such holes \
+     (--min-hole-area {:.3e} drops every hole up to a little above this one's area) or use a cell size of at \
+     most half its width (--cell-size {:.3e}) (the check reported: {detail})",
+    at[0], at[1],
+    if *others > 0 { format!(", and {others} other hole(s) are narrower than a cell too") } else { String::new() },
+    area * 1.001, width / 2.0
+)]
+pub struct SmallHole {
+    /// The hole (0-based, as in the input).
+    pub hole: usize,
+    /// Its width: the smaller side of its bounding box.
+    pub width: f64,
+    /// The centre of its bounding box.
+    pub at: [f64; 2],
+    /// Its area.
+    pub area: f64,
+    /// The cell size.
+    pub h: f64,
+    /// Listed failing cells (non-convex: a corner within `h` of it; outside: the centroid)
+    /// beside it.
+    pub cells: usize,
+    /// Other holes of the region narrower than `h`.
+    pub others: usize,
+    /// The verification's own message.
+    pub detail: String,
+}
+
+/// The width of `hole` for [`SmallHole`]: the smaller side of its bounding box.
+fn hole_width(hole: &unamalla_mesh::Polygon) -> (f64, DVec2) {
+    let (lo, hi) = hole.points().iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let d = hi - lo;
+    (d.x.min(d.y), 0.5 * (lo + hi))
+}
+
+/// The hole next to which the failing cells of `v` lie when it is narrower than the cell size
+/// `h` (the hole with the most listed failing cells within `h`; ties: the lowest index), or
+/// `None`. A listed cell is within `h` of a hole when one of its corners is (a cell outside:
+/// its centroid). Each listed cell (at most [`crate::verify::LISTED_CELLS`] per kind) is
+/// compared with every edge of every hole: the work is linear in the holes' vertices.
+pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> Option<SmallHole> {
+    if h.is_nan() || h <= 0.0 || region.holes().is_empty() {
+        return None;
+    }
+    // each listed cell by its points: the corners of a non-convex cell (a folded cell can be
+    // long: its centroid may lie several cells from the hole its corners touch), the centroid
+    // of a cell outside
+    let cells: Vec<Vec<DVec2>> = v
+        .non_convex_at
+        .iter()
+        .map(|c| c.iter().map(|p| DVec2::new(p[0], p[1])).collect())
+        .chain(
+            v.outside_examples
+                .iter()
+                .map(|(_, p)| vec![DVec2::new(p[0], p[1])]),
+        )
+        .collect();
+    let narrow: Vec<bool> = region
+        .holes()
+        .iter()
+        .map(|hole| hole_width(hole).0 < h)
+        .collect();
+    let mut count = vec![0usize; region.holes().len()];
+    for pts in &cells {
+        let nearest = region
+            .holes()
+            .iter()
+            .enumerate()
+            .map(|(k, hole)| {
+                let q = hole.points();
+                let d = pts
+                    .iter()
+                    .flat_map(|&p| {
+                        (0..q.len())
+                            .map(move |i| point_segment_distance(p, q[i], q[(i + 1) % q.len()]))
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                (k, d)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        if let Some((k, d)) = nearest {
+            if d <= h && narrow[k] {
+                count[k] += 1;
+            }
+        }
+    }
+    let (hole, &cells) = count
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))?;
+    if cells == 0 {
+        return None;
+    }
+    let (width, c) = hole_width(&region.holes()[hole]);
+    Some(SmallHole {
+        hole,
+        width,
+        at: [c.x, c.y],
+        area: region.holes()[hole].area().abs(),
+        h,
+        cells,
+        others: narrow.iter().filter(|&&n| n).count() - 1,
+        detail: v.to_string(),
+    })
 }
 
 fn ring_name(k: usize) -> String {
@@ -386,8 +502,15 @@ pub fn explain_failure(e: CoreError, region: &Region, h: f64) -> CoreError {
 /// The guarantee error `e` of a finished mesh, explained like [`explain_failure`]: when
 /// `region` has two rings closer than [`MIN_GAP_FRACTION`] × `h` the cause is that gap (an
 /// input the size cannot mesh, [`PreflightError::NarrowGap`] with the verification's failures
-/// as the detail), not the cells it produced there; otherwise `e` unchanged.
+/// as the detail), not the cells it produced there; when the failing cells lie next to a hole
+/// narrower than the cell size, that hole ([`PreflightError::SmallHole`], [`small_hole`]);
+/// otherwise `e` unchanged.
 pub fn explain_guarantee(e: crate::verify::GuaranteeNotMet, region: &Region, h: f64) -> CoreError {
+    if let Some(s) = small_hole(&e.0, region, h) {
+        if !ring_gaps(region).is_some_and(|(_, _, gap)| gap < MIN_GAP_FRACTION * h) {
+            return CoreError::Preflight(PreflightError::SmallHole(Box::new(s)));
+        }
+    }
     match ring_gaps(region) {
         Some((a, b, gap)) if h > 0.0 && gap < MIN_GAP_FRACTION * h => {
             CoreError::Preflight(PreflightError::NarrowGap {
@@ -438,6 +561,72 @@ mod tests {
         .unwrap();
         // an overflowing count (inf) is too large, not accepted
         assert!(check_size("--size", "x", f64::INFINITY, "nodes", 1.0, u64::MAX).is_err());
+    }
+
+    /// A 10 × 10 square with three clockwise square holes: A (0.4 wide, centred at (5, 5)),
+    /// B (0.3 wide, at (2, 2)) and C (2 wide, at (7, 2)).
+    fn three_holes() -> Region {
+        let sq = |c: DVec2, w: f64| {
+            let r = 0.5 * w;
+            vec![
+                c + DVec2::new(-r, -r),
+                c + DVec2::new(-r, r),
+                c + DVec2::new(r, r),
+                c + DVec2::new(r, -r),
+            ]
+        };
+        Region::new(
+            sq(DVec2::new(5.0, 5.0), 10.0).into_iter().rev().collect(),
+            vec![
+                sq(DVec2::new(5.0, 5.0), 0.4),
+                sq(DVec2::new(2.0, 2.0), 0.3),
+                sq(DVec2::new(7.0, 2.0), 2.0),
+            ],
+        )
+        .unwrap()
+    }
+
+    /// Two failing cells beside hole A, one beside the wide hole C: at cell size 0.63 the
+    /// cause named is hole 0 (A: narrower than a cell, 2 cells within h), with B counted as
+    /// the other narrow hole and the remedies computed from A (area 0.16, half width 0.2); at
+    /// cell size 0.3 (below A's width) no hole is blamed.
+    #[test]
+    fn failing_cells_beside_a_hole_narrower_than_a_cell_name_the_hole() {
+        let r = three_holes();
+        // a cell of 0.1 × 0.1 with its lower left corner at (x, y)
+        let cell = |x: f64, y: f64| [[x, y], [x + 0.1, y], [x + 0.1, y + 0.1], [x, y + 0.1]];
+        let v = crate::verify::Verification {
+            cells: 100,
+            non_convex_cells: 3,
+            non_convex_examples: vec![1, 2, 3],
+            non_convex_at: vec![cell(5.5, 5.0), cell(5.0, 4.6), cell(8.2, 2.0)],
+            min_corner: -1.0,
+            ..Default::default()
+        };
+        let s = small_hole(&v, &r, 0.63).expect("hole A is blamed");
+        assert_eq!((s.hole, s.cells, s.others), (0, 2, 1));
+        assert!((s.width - 0.4).abs() < 1e-12 && (s.area - 0.16).abs() < 1e-12);
+        assert_eq!(s.at, [5.0, 5.0]);
+        let msg = explain_guarantee(
+            crate::verify::GuaranteeNotMet(Box::new(v.clone())),
+            &r,
+            0.63,
+        )
+        .to_string();
+        assert!(msg.contains("hole 0 (4.000e-1 across"), "{msg}");
+        // 0.16 × 1.001, printed above 0.16 so that the suggested option does drop the hole
+        assert!(msg.contains("--min-hole-area 1.602e-1"), "{msg}");
+        assert!(!msg.contains("  "), "{msg}");
+        assert!(msg.contains("--cell-size 2.000e-1"), "{msg}");
+        assert!(msg.contains("1 other hole(s)"), "{msg}");
+        assert!(msg.contains("3 of 100 cells are not convex"), "{msg}");
+        assert!(small_hole(&v, &r, 0.3).is_none());
+        // failing cells far from every narrow hole: not blamed on a hole
+        let far = crate::verify::Verification {
+            non_convex_at: vec![cell(9.5, 9.5)],
+            ..v
+        };
+        assert!(small_hole(&far, &r, 0.63).is_none());
     }
 
     #[test]

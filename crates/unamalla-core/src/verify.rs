@@ -70,6 +70,9 @@ pub struct Verification {
     pub non_convex_cells: usize,
     /// The first [`LISTED_CELLS`] of them.
     pub non_convex_examples: Vec<usize>,
+    /// The corners of [`Self::non_convex_examples`] (quads; empty for hexes), so that a
+    /// failure can be located against the region (`preflight::explain_guarantee`).
+    pub non_convex_at: Vec<[[f64; 2]; 4]>,
     /// Smallest corner value `α_k` (quads: twice the corner triangle's area; hexes: `V`).
     pub min_corner: f64,
     /// Cells whose centroid is outside the region (`None`: no region given).
@@ -224,6 +227,7 @@ pub fn verify_quads<M: HasQuadCells>(
             v.non_convex_cells += 1;
             if v.non_convex_examples.len() < LISTED_CELLS {
                 v.non_convex_examples.push(c);
+                v.non_convex_at.push(p.map(|q| [q.x, q.y]));
             }
         }
     }
@@ -242,7 +246,10 @@ pub fn verify_quads<M: HasQuadCells>(
                 v.outside_examples.push((c, [centroid.x, centroid.y]));
             }
         }
-        area += 0.5 * (0..4).map(|k| p[k].perp_dot(p[(k + 1) % 4])).sum::<f64>();
+        // the signed area from the diagonals, `½ (p₂ − p₀) × (p₃ − p₁)` (the shoelace sum of
+        // the corner coordinates themselves cancels catastrophically far from the origin: at
+        // 10⁹ its terms are 10¹⁸ for cells of unit area)
+        area += 0.5 * (p[2] - p[0]).perp_dot(p[3] - p[1]);
     }
     let ra = region.area();
     v.centroids_outside = Some(outside);
@@ -428,6 +435,25 @@ mod tests {
             }
         }
         QuadMesh::new(nodes, cells).unwrap()
+    }
+
+    /// The same region and mesh moved to (10⁹, 10⁹): every coordinate is exact there
+    /// (integers below 2⁵³), so the area must still be exactly 8 (the shoelace sum of the
+    /// coordinates themselves gave 0 at this offset: terms of 10¹⁸ cancelling).
+    #[test]
+    fn the_area_check_holds_far_from_the_origin() {
+        let o = DVec2::splat(1e9);
+        let r = square_with_hole();
+        let r = Region::new(
+            r.outer().points().iter().map(|&p| p + o).collect(),
+            vec![r.holes()[0].points().iter().map(|&p| p + o).collect()],
+        )
+        .unwrap();
+        let mut m = ring_mesh();
+        m.nodes_mut().iter_mut().for_each(|p| *p += o);
+        let v = verify_quads(&m, Some(&r), &VerifyOptions::default());
+        assert!(v.passed(), "{v}");
+        assert_eq!(v.mesh_area, Some(8.0));
     }
 
     #[test]

@@ -610,11 +610,17 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
         if c.a == c.b {
             return Err(err);
         }
-        // endpoints may sit a rounding error off the boundary: test the segment shrunk by a
-        // relative 1e-9 at both ends
+        // endpoints may sit a rounding error off the boundary: test the segment shrunk at both
+        // ends by a relative 1e-9 or, far from the origin, by 64 units in the last place of
+        // the coordinates (at 10⁹ an ulp is 1.2·10⁻⁷, so a 1e-9 shrink of a short cut does
+        // not move its ends at all)
         let d = c.b - c.a;
-        let a2 = c.a + 1e-9 * d;
-        let b2 = c.b - 1e-9 * d;
+        let scale = c.a.abs().max(c.b.abs()).max_element();
+        let shrink = (1e-9f64)
+            .max(64.0 * f64::EPSILON * scale / d.length())
+            .min(0.25);
+        let a2 = c.a + shrink * d;
+        let b2 = c.b - shrink * d;
         if !(region.contains_point(a2)
             && region.contains_point(b2)
             && !index.open_segment_blocked(a2, b2))

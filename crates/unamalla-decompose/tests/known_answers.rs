@@ -424,3 +424,36 @@ fn a_sliver_island_keeps_no_spike_in_any_block() {
     let at_tip = d.blocks.iter().filter(|b| b.ring.contains(&tip)).count();
     assert!(at_tip >= 2, "the tip is a vertex of {at_tip} block(s)");
 }
+
+/// An L of 2 × 2 units (a unit notch) at the origin and moved to (10⁹, 10⁹), where an ulp of
+/// the coordinates is 1.2·10⁻⁷: the same layout (one cut from the reflex vertex, two blocks)
+/// and a valid tiling — the cut test once shrank the cut by a relative 10⁻⁹, which does not move
+/// its ends at that offset, and rejected it as touching the boundary.
+#[test]
+fn an_l_far_from_the_origin_is_cut_like_the_l_at_the_origin() {
+    let l = |o: f64| {
+        Region::new(
+            vec![
+                v(o, o),
+                v(o + 2.0, o),
+                v(o + 2.0, o + 1.0),
+                v(o + 1.0, o + 1.0),
+                v(o + 1.0, o + 2.0),
+                v(o, o + 2.0),
+            ],
+            vec![],
+        )
+        .unwrap()
+    };
+    let r0 = l(0.0);
+    let d0 = decompose(&r0, &thesis()).unwrap();
+    assert_eq!((d0.blocks.len(), d0.cuts.len()), (2, 1));
+    let r9 = l(1e9);
+    let d9 = decompose(&r9, &thesis()).unwrap();
+    assert_eq!((d9.blocks.len(), d9.cuts.len()), (2, 1));
+    // the cut starts at the reflex vertex (o + 1, o + 1) and is the same cut as at the origin
+    let (c0, c9) = (&d0.cuts[0], &d9.cuts[0]);
+    assert_eq!(c9.a - DVec2::splat(1e9), c0.a);
+    assert_eq!(c9.b - DVec2::splat(1e9), c0.b);
+    check_tiling(&r9, &d9);
+}

@@ -266,6 +266,12 @@ pub struct Session<'o> {
     mask: Vec<bool>,
     group: usize,
     meas: Vec<f64>,
+    /// Scratch of [`crossing_times`](Self::crossing_times): the measures at `x ± d` and the
+    /// point `x ± d` (kept between calls: the fraction-to-the-boundary test runs up to six
+    /// times per iteration on ~10⁵ elements).
+    scratch_plus: Vec<f64>,
+    scratch_minus: Vec<f64>,
+    scratch_x: Vec<f64>,
     /// Absolute threshold of the safeguard (see the type docs).
     pub guard_threshold: f64,
     /// Whether the safeguard is on.
@@ -319,6 +325,9 @@ impl<'o> Session<'o> {
             mask,
             group: if problem.dim() == 3 { 10 } else { 4 },
             meas: a,
+            scratch_plus: Vec::new(),
+            scratch_minus: Vec::new(),
+            scratch_x: Vec::new(),
             guard_threshold: 0.0,
             guard: true,
             active_threshold: None,
@@ -437,79 +446,126 @@ impl<'o> Session<'o> {
     /// above the threshold on `[0, t)` along `x + t·d`, computed exactly in 2D (α is quadratic
     /// in `t`: three evaluations at `t = −1, 0, 1`); `+∞` in 3D (where the search bisects).
     pub fn max_step<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64], d: &[f64]) -> f64 {
+        self.max_step_within(problem, x, d, f64::INFINITY)
+    }
+
+    /// [`max_step`](Self::max_step) for a caller that only needs `min(t, horizon)`: every
+    /// crossing at or beyond `horizon` may be reported as `+∞`. An element whose measure
+    /// cannot reach the threshold before `horizon` — `c₀ − thr > |b|·h + |a|·h²` for
+    /// `α(t) = a·t² + b·t + c₀` — skips the root computation (most elements of a smoothing
+    /// step are far from the threshold), so the result is the same as `max_step`'s whenever
+    /// that is below `horizon`.
+    pub fn max_step_within<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+        d: &[f64],
+        horizon: f64,
+    ) -> f64 {
+        if problem.dim() != 2 {
+            return f64::INFINITY;
+        }
+        let mut a0 = std::mem::take(&mut self.meas);
+        problem.element_measures(x, &mut a0);
         let mut times = Vec::new();
-        self.crossing_times(problem, x, d, &mut times);
+        self.crossing_times(problem, x, &a0, d, horizon, &mut times);
+        self.meas = a0;
         times.into_iter().fold(f64::INFINITY, f64::min)
     }
 
     /// Per element, the first `t > 0` at which its measure reaches the threshold along
     /// `x + t·d` (`+∞` if never, for unmasked elements, for elements already at or below the
-    /// threshold, and for every element in 3D); see [`max_step`](Self::max_step).
+    /// threshold, and possibly for crossings at or beyond `horizon`: see
+    /// [`max_step_within`](Self::max_step_within)); 2D only (see
+    /// [`max_step`](Self::max_step)). `a0` holds the measures at `x`
+    /// (computed once by the caller: [`hold_back`](Self::hold_back) asks for the times of up
+    /// to five directions from the same `x`).
+    ///
+    /// The measure is `α(t) = a·t² + b·t + c₀` with `b = (α(1) − α(−1))/2`,
+    /// `a = (α(1) + α(−1))/2 − α(0)`; the root of `α(t) = thr` is taken in the cancellation-free
+    /// form `q = −(b + sign(b)·√(b² − 4ac))/2`, roots `q/a` and `c/q` (`c = α(0) − thr`). The
+    /// elements are independent, so the loop runs in parallel; every time is computed by the
+    /// same arithmetic whatever the thread count.
     fn crossing_times<P: Problem + ?Sized>(
         &mut self,
         problem: &P,
         x: &[f64],
+        a0: &[f64],
         d: &[f64],
+        horizon: f64,
         out: &mut Vec<f64>,
     ) {
-        let ne = self.meas.len();
+        use rayon::prelude::*;
+        let ne = a0.len();
         out.clear();
         out.resize(ne, f64::INFINITY);
-        if problem.dim() != 2 {
-            return;
-        }
-        let mut a0 = std::mem::take(&mut self.meas);
-        let mut ap = vec![0.0; ne];
-        let mut am = vec![0.0; ne];
-        let mut xt: Vec<f64> = x.iter().zip(d).map(|(a, b)| a + b).collect();
-        problem.element_measures(x, &mut a0);
+        let mut ap = std::mem::take(&mut self.scratch_plus);
+        let mut am = std::mem::take(&mut self.scratch_minus);
+        let mut xt = std::mem::take(&mut self.scratch_x);
+        ap.resize(ne, 0.0);
+        am.resize(ne, 0.0);
+        xt.clear();
+        xt.extend(x.iter().zip(d).map(|(a, b)| a + b));
         problem.element_measures(&xt, &mut ap);
         xt.iter_mut()
             .zip(x.iter().zip(d))
             .for_each(|(t, (a, b))| *t = a - b);
         problem.element_measures(&xt, &mut am);
         let thr = self.threshold();
-        for (i, t_out) in out.iter_mut().enumerate() {
-            if !self.mask[i] {
-                continue;
-            }
-            let c = a0[i] - thr;
-            if c <= 0.0 {
-                continue;
-            }
-            let b = 0.5 * (ap[i] - am[i]);
-            let a = 0.5 * (ap[i] + am[i]) - a0[i];
-            *t_out = if a.abs() <= 1e-14 * (b.abs() + c) {
-                if b < 0.0 {
-                    -c / b
-                } else {
-                    f64::INFINITY
+        let mask = &self.mask;
+        out.par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, t_out)| {
+                if !mask[i] {
+                    return;
                 }
-            } else {
-                let disc = b * b - 4.0 * a * c;
-                if disc < 0.0 {
-                    f64::INFINITY
-                } else {
-                    let q = -0.5 * (b + b.signum() * disc.sqrt());
-                    let (r1, r2) = (q / a, c / q);
-                    let mut r = f64::INFINITY;
-                    for v in [r1, r2] {
-                        if v > 0.0 && v < r {
-                            r = v;
-                        }
+                let c = a0[i] - thr;
+                if c <= 0.0 {
+                    return;
+                }
+                let b = 0.5 * (ap[i] - am[i]);
+                let a = 0.5 * (ap[i] + am[i]) - a0[i];
+                // |α(t) − α(0)| ≤ |b|·h + |a|·h² on [0, h]: no crossing before the horizon
+                // (with a relative margin far above the rounding of the root below)
+                let reach = b.abs() * horizon + a.abs() * horizon * horizon;
+                if c > reach * (1.0 + 1e-9) {
+                    return;
+                }
+                *t_out = if a.abs() <= 1e-14 * (b.abs() + c) {
+                    if b < 0.0 {
+                        -c / b
+                    } else {
+                        f64::INFINITY
                     }
-                    r
-                }
-            };
-        }
-        self.meas = a0;
+                } else {
+                    let disc = b * b - 4.0 * a * c;
+                    if disc < 0.0 {
+                        f64::INFINITY
+                    } else {
+                        let q = -0.5 * (b + b.signum() * disc.sqrt());
+                        let (r1, r2) = (q / a, c / q);
+                        let mut r = f64::INFINITY;
+                        for v in [r1, r2] {
+                            if v > 0.0 && v < r {
+                                r = v;
+                            }
+                        }
+                        r
+                    }
+                };
+            });
+        self.scratch_plus = ap;
+        self.scratch_minus = am;
+        self.scratch_x = xt;
     }
 
     /// Holds back the nodes that block the step `d` from `x`: the direction components of
     /// every free node of an element that would reach the threshold before `t = reach` are
     /// set to zero, repeated (at most four rounds) until no element blocks or nothing more can
     /// be held back. Returns the fraction-to-boundary step of the resulting `d`
-    /// ([`max_step`](Self::max_step)).
+    /// ([`max_step_within`](Self::max_step_within) with the horizon `max(reach, 1)`: a step of
+    /// at least that may be returned as `+∞`).
     ///
     /// Shortening the whole step instead (the plain fraction-to-the-boundary rule) stalls
     /// every node as soon as one cell sits at the safeguard's threshold — the situation of a
@@ -524,10 +580,18 @@ impl<'o> Session<'o> {
         reach: f64,
     ) -> f64 {
         let dim = problem.dim();
+        if dim != 2 {
+            return f64::INFINITY;
+        }
         let mut times = Vec::new();
         let mut nodes = Vec::new();
+        let mut a0 = std::mem::take(&mut self.meas);
+        problem.element_measures(x, &mut a0);
+        // only crossings before `reach` are held back, and the caller compares the returned
+        // step with 1
+        let horizon = reach.max(1.0);
         for _ in 0..4 {
-            self.crossing_times(problem, x, d, &mut times);
+            self.crossing_times(problem, x, &a0, d, horizon, &mut times);
             let mut moved = 0usize;
             for (e, &t) in times.iter().enumerate() {
                 if t >= reach {
@@ -547,10 +611,13 @@ impl<'o> Session<'o> {
                 }
             }
             if moved == 0 {
+                self.meas = a0;
                 return times.into_iter().fold(f64::INFINITY, f64::min);
             }
         }
-        self.max_step(problem, x, d)
+        self.crossing_times(problem, x, &a0, d, horizon, &mut times);
+        self.meas = a0;
+        times.into_iter().fold(f64::INFINITY, f64::min)
     }
 
     /// Sets the phase of the following iterations.

@@ -760,7 +760,8 @@ fn truncated_newton<P: Problem + ?Sized>(
                 }
                 if guard {
                     // fraction to the boundary of the admissible set
-                    let mut tm = session.max_step(problem, xr, &w.z);
+                    // (only `min(tm, 1)` is used below)
+                    let mut tm = session.max_step_within(problem, xr, &w.z, 1.0);
                     if tm < 1.0 {
                         // hold back the nodes of the blocking cells instead (so that one cell
                         // at the threshold does not stall the whole mesh, nor creep towards
