@@ -114,25 +114,70 @@ pub fn writing<T>(target: &Path, f: impl FnOnce() -> Result<T>) -> Result<T> {
     f().context(WriteFailed(format!("writing {}", target.display())))
 }
 
-/// Arguments of `unamalla mesh`.
+/// Arguments of `unamalla mesh` (the options of the subcommand).
+#[derive(clap::Args, Debug)]
 pub struct MeshArgs {
+    /// Region file: GeoJSON, Shapefile (.shp), UNAMALLA .con or plain text rings.
     pub region: PathBuf,
+    /// Use this decomposition file (made for the simplified region, or for the raw region
+    /// together with --no-simplify) instead of the automatic one.
+    #[arg(long)]
     pub decomposition: Option<PathBuf>,
+    /// Decomposition strategy: cuts (seed 000, default), submap (seed 002 submapping), or
+    /// auto (submap when every angle is within 10° of a multiple of 90° and no vertex
+    /// reclassification is needed, else cuts).
+    #[arg(long, default_value = "cuts", value_parser = ["cuts", "submap", "auto"])]
     pub strategy: String,
+    /// About this many cells (default 20000; at least 1).
+    #[arg(long, conflicts_with_all = ["density", "cell_size"], allow_negative_numbers = true, value_parser = crate::reliability::positive_count)]
     pub cells: Option<usize>,
+    /// The thesis's density factor d (at least 1).
+    #[arg(long, conflicts_with = "cell_size", allow_negative_numbers = true, value_parser = crate::reliability::positive_count)]
     pub density: Option<usize>,
+    /// Target cell size in region units.
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::reliability::finite_number)]
     pub cell_size: Option<f64>,
+    /// Boundary density w of (6.9) (1 = plain (6.8)).
+    #[arg(long, default_value_t = 1.0)]
     pub boundary_density: f64,
+    /// Drop holes smaller than this area (region units squared); by default every hole is kept.
+    #[arg(long)]
     pub min_hole_area: Option<f64>,
+    /// Mesh the region as given, without contour simplification.
+    #[arg(long)]
     pub no_simplify: bool,
+    /// Remove boundary features whose modified-area measure is below this many squared
+    /// target cell sizes (0 keeps every feature the simplification kept).
+    #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_FEATURE_FACTOR)]
     pub feature_factor: f64,
+    /// Cut off spits and fill inlets behind a neck narrower than this many target cell
+    /// sizes (and thinner than that on average); 0 keeps them. Each cut is listed in
+    /// report.json's notes.
+    #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_NECK_FACTOR)]
     pub neck_factor: f64,
+    /// Stop smoothing after this many seconds of wall-clock time (status "STOP by TIME
+    /// LIMIT"). By default there is no limit: smoothing stops on convergence, so the mesh
+    /// does not depend on the machine.
+    #[arg(long)]
     pub time_limit: Option<f64>,
+    /// For a MultiPolygon: `all` (the default: every part is meshed, into `part-K/`
+    /// subdirectories with a summary `report.json`) or one part's 0-based index.
+    #[arg(long, value_parser = crate::reliability::parse_part)]
     pub part: Option<PartArg>,
+    /// Write the mesh even if it fails the independent check (non-convex cells, cells
+    /// outside the region, area or holes off), with a warning and exit code 3.
+    #[arg(long)]
     pub allow_non_convex: bool,
+    /// Output directory (replaced as a whole: it must be new, empty or a previous output).
+    #[arg(short, long)]
     pub output: PathBuf,
+    /// Print report.json on stdout.
+    #[arg(long)]
     pub json: bool,
+    /// No progress output.
+    #[arg(long)]
     pub quiet: bool,
+    #[command(flatten)]
     pub gis: SolverGisArgs,
 }
 

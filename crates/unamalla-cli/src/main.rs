@@ -47,7 +47,6 @@ mod report;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
-use reliability::{finite_number, parse_part, positive_count, PartArg};
 use unamalla_core::io::{self, VtkMesh};
 use unamalla_core::mesh::quality::{quad_cell_metrics, QualityReport};
 use unamalla_core::single_block::{tfi_region, Corners};
@@ -97,70 +96,7 @@ enum Command {
         allow_non_convex: bool,
     },
     /// The main job: a block-structured, singularity-free, all-convex quad mesh of a region.
-    Mesh {
-        /// Region file: GeoJSON, Shapefile (.shp), UNAMALLA .con or plain text rings.
-        region: PathBuf,
-        /// Use this decomposition file (made for the simplified region, or for the raw region
-        /// together with --no-simplify) instead of the automatic one.
-        #[arg(long)]
-        decomposition: Option<PathBuf>,
-        /// Decomposition strategy: cuts (seed 000, default), submap (seed 002 submapping), or
-        /// auto (submap when every angle is within 10° of a multiple of 90° and no vertex
-        /// reclassification is needed, else cuts).
-        #[arg(long, default_value = "cuts", value_parser = ["cuts", "submap", "auto"])]
-        strategy: String,
-        /// About this many cells (default 20000; at least 1).
-        #[arg(long, conflicts_with_all = ["density", "cell_size"], allow_negative_numbers = true, value_parser = positive_count)]
-        cells: Option<usize>,
-        /// The thesis's density factor d (at least 1).
-        #[arg(long, conflicts_with = "cell_size", allow_negative_numbers = true, value_parser = positive_count)]
-        density: Option<usize>,
-        /// Target cell size in region units.
-        #[arg(long, allow_negative_numbers = true, value_parser = finite_number)]
-        cell_size: Option<f64>,
-        /// Boundary density w of (6.9) (1 = plain (6.8)).
-        #[arg(long, default_value_t = 1.0)]
-        boundary_density: f64,
-        /// Drop holes smaller than this area (region units squared); by default every hole is kept.
-        #[arg(long)]
-        min_hole_area: Option<f64>,
-        /// Mesh the region as given, without contour simplification.
-        #[arg(long)]
-        no_simplify: bool,
-        /// Remove boundary features whose modified-area measure is below this many squared
-        /// target cell sizes (0 keeps every feature the simplification kept).
-        #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_FEATURE_FACTOR)]
-        feature_factor: f64,
-        /// Cut off spits and fill inlets behind a neck narrower than this many target cell
-        /// sizes (and thinner than that on average); 0 keeps them. Each cut is listed in
-        /// report.json's notes.
-        #[arg(long, default_value_t = unamalla_core::pipeline::DEFAULT_NECK_FACTOR)]
-        neck_factor: f64,
-        /// Stop smoothing after this many seconds of wall-clock time (status "STOP by TIME
-        /// LIMIT"). By default there is no limit: smoothing stops on convergence, so the mesh
-        /// does not depend on the machine.
-        #[arg(long)]
-        time_limit: Option<f64>,
-        /// For a MultiPolygon: `all` (the default: every part is meshed, into `part-K/`
-        /// subdirectories with a summary `report.json`) or one part's 0-based index.
-        #[arg(long, value_parser = parse_part)]
-        part: Option<PartArg>,
-        /// Write the mesh even if it fails the independent check (non-convex cells, cells
-        /// outside the region, area or holes off), with a warning and exit code 3.
-        #[arg(long)]
-        allow_non_convex: bool,
-        /// Output directory (replaced as a whole: it must be new, empty or a previous output).
-        #[arg(short, long)]
-        output: PathBuf,
-        /// Print report.json on stdout.
-        #[arg(long)]
-        json: bool,
-        /// No progress output.
-        #[arg(long)]
-        quiet: bool,
-        #[command(flatten)]
-        gis: commands::SolverGisArgs,
-    },
+    Mesh(commands::MeshArgs),
     /// Value and gradient norm of a functional on a mesh (VTK legacy file).
     Eval {
         /// Mesh file.
@@ -354,45 +290,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             reliability::finish(not_met)?;
         }
-        Command::Mesh {
-            region,
-            decomposition,
-            strategy,
-            cells,
-            density,
-            cell_size,
-            boundary_density,
-            min_hole_area,
-            no_simplify,
-            feature_factor,
-            neck_factor,
-            time_limit,
-            part,
-            allow_non_convex,
-            output,
-            json,
-            quiet,
-            gis,
-        } => commands::mesh(commands::MeshArgs {
-            region,
-            decomposition,
-            strategy,
-            cells,
-            density,
-            cell_size,
-            boundary_density,
-            min_hole_area,
-            no_simplify,
-            feature_factor,
-            neck_factor,
-            time_limit,
-            part,
-            allow_non_convex,
-            output,
-            json,
-            quiet,
-            gis,
-        })?,
+        Command::Mesh(a) => commands::mesh(a)?,
         Command::Eval {
             mesh,
             functional,
