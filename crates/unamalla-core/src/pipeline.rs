@@ -186,6 +186,9 @@ pub struct Mesher {
     strategy: Strategy,
     allow_non_convex: bool,
     coarse_levels: usize,
+    /// Candidate layouts [`choose_layout`] must not pick (set by the fallback of
+    /// [`Mesher::mesh_observed`] after a layout failed the guarantee).
+    excluded_layouts: Vec<String>,
 }
 
 impl Default for Mesher {
@@ -249,7 +252,8 @@ pub struct MeshReport {
     pub holes_dropped: Vec<usize>,
     /// Smoother status message.
     pub smoothing: String,
-    /// Total wall time in seconds.
+    /// Total wall time in seconds (with a layout fallback of [`Mesher::mesh_observed`]: of
+    /// every attempt; `stage_seconds` are those of the attempt kept).
     pub seconds: f64,
     /// Wall time per stage.
     pub stage_seconds: Vec<(Stage, f64)>,
@@ -288,6 +292,7 @@ impl Mesher {
             strategy: Strategy::Cuts,
             allow_non_convex: false,
             coarse_levels: crate::multilevel::DEFAULT_COARSE_LEVELS,
+            excluded_layouts: Vec::new(),
         }
     }
     /// The decomposition strategy (default [`Strategy::Cuts`]).
@@ -486,13 +491,17 @@ impl Mesher {
     /// work, the mesh is checked independently ([`crate::verify::verify_quads`]: convex cells,
     /// centroids inside the meshed region, its area and hole count; the area against the input
     /// region within [`INPUT_AREA_TOLERANCE`] unless holes were dropped on purpose); a failure is
-    /// [`CoreError::Guarantee`] unless [`Mesher::allow_non_convex`] was set.
+    /// [`CoreError::Guarantee`] unless [`Mesher::allow_non_convex`] was set. When the layout was
+    /// chosen automatically and the mesh has non-convex cells, the mesh is re-made from the next
+    /// candidate layouts (at most [`LAYOUT_FALLBACKS`] more runs; the report's notes name each
+    /// layout that failed).
     pub fn mesh_observed(
-        self,
+        mut self,
         region: &Region,
         observer: &mut dyn Observer,
     ) -> Result<MeshResult, CoreError> {
         use crate::preflight;
+        let t_start = Instant::now();
         let h = self.submap_size(region);
         let limit = preflight::memory_limit()?;
         let (option, value) = match self.size {
@@ -520,17 +529,50 @@ impl Mesher {
                 preflight::check_narrow_features(region, h)?;
             }
         }
+        let verify = |result: &MeshResult| {
+            let mut v = crate::verify::verify_quads(
+                result.mesh.global(),
+                Some(&result.simplified),
+                &crate::verify::VerifyOptions::default(),
+            );
+            if result.report.holes_dropped.is_empty() {
+                v.input_area_defect = Some(result.report.area_change_percent / 100.0);
+                v.input_area_tolerance = Some(INPUT_AREA_TOLERANCE);
+            }
+            v
+        };
         let mut result = self
             .mesh_unverified(region, observer)
             .map_err(|e| preflight::explain_failure(e, region, h))?;
-        let mut v = crate::verify::verify_quads(
-            result.mesh.global(),
-            Some(&result.simplified),
-            &crate::verify::VerifyOptions::default(),
-        );
-        if result.report.holes_dropped.is_empty() {
-            v.input_area_defect = Some(result.report.area_change_percent / 100.0);
-            v.input_area_tolerance = Some(INPUT_AREA_TOLERANCE);
+        let mut v = verify(&result);
+        // fallback: a mesh of an automatically chosen layout with cells left folded (a block
+        // whose transfinite start no untangling can fix, e.g. a side notched deeper than its
+        // cells) is re-made from the next candidate layout, best predicted first, at most
+        // [`LAYOUT_FALLBACKS`] times; every attempt is named in the report's notes
+        let mut failed: Vec<String> = Vec::new();
+        while !allow && v.non_convex_cells > 0 && failed.len() < LAYOUT_FALLBACKS {
+            let Some(choice) = result.report.layout.as_ref() else {
+                break;
+            };
+            failed.push(format!(
+                "layout {} left {} non-convex cell(s); re-made from the next candidate layout",
+                choice.layout, v.non_convex_cells
+            ));
+            self.excluded_layouts.push(choice.layout.clone());
+            let retry = match self.mesh_unverified(region, observer) {
+                Ok(r) => r,
+                // no candidate left, or the next one fails in a stage: keep the first failure
+                Err(_) => break,
+            };
+            let rv = verify(&retry);
+            result = retry;
+            v = rv;
+        }
+        if !failed.is_empty() {
+            result.report.seconds = t_start.elapsed().as_secs_f64();
+            let mut notes = failed;
+            notes.append(&mut result.report.notes);
+            result.report.notes = notes;
         }
         result.report.verification = v.clone();
         if !allow {
@@ -542,7 +584,7 @@ impl Mesher {
 
     /// The pipeline without the checks of [`Mesher::mesh_observed`].
     fn mesh_unverified(
-        mut self,
+        &mut self,
         region: &Region,
         observer: &mut dyn Observer,
     ) -> Result<MeshResult, CoreError> {
@@ -633,7 +675,12 @@ impl Mesher {
                                 decompose(&simplified, &opts)?
                             }
                             None => {
-                                let (d, choice) = choose_layout(&simplified, &opts, self.size)?;
+                                let (d, choice) = choose_layout_excluding(
+                                    &simplified,
+                                    &opts,
+                                    self.size,
+                                    &self.excluded_layouts,
+                                )?;
                                 layout_choice = Some(choice);
                                 d
                             }
@@ -960,6 +1007,11 @@ fn boundary_hausdorff(mesh: &BlockMesh2, region: &Region) -> f64 {
     worst
 }
 
+/// At most this many other candidate layouts are tried after the automatically chosen one
+/// left non-convex cells ([`Mesher::mesh_observed`]); each try is a whole run of the
+/// pipeline, so the work is bounded by `1 + LAYOUT_FALLBACKS` runs.
+pub const LAYOUT_FALLBACKS: usize = 2;
+
 /// Margin (share of cells) by which the chord layout's prediction must beat the concavity
 /// layout's to be chosen: the prediction is made on a coarse mesh with a few Laplacian sweeps,
 /// so differences below a percent are not resolved by it (`tests/predictor.rs`).
@@ -1066,6 +1118,18 @@ pub fn choose_layout(
     opts: &DecomposeOptions,
     size: MeshSize,
 ) -> Result<(Decomposition, LayoutChoice), CoreError> {
+    choose_layout_excluding(region, opts, size, &[])
+}
+
+/// [`choose_layout`] without the candidates named in `excluded` (the names of
+/// [`LayoutChoice::layout`]: `concavity` and those of [`LAYOUT_ASPECTS`]); when every
+/// candidate is excluded, the same error as when none can be built.
+pub fn choose_layout_excluding(
+    region: &Region,
+    opts: &DecomposeOptions,
+    size: MeshSize,
+    excluded: &[String],
+) -> Result<(Decomposition, LayoutChoice), CoreError> {
     // (name, layout cuts for a chord layout, decomposition)
     type Cand = (&'static str, Option<Vec<(DVec2, DVec2)>>, Decomposition);
     // the candidate layouts are independent: built (and predicted below) in parallel, the
@@ -1104,6 +1168,7 @@ pub fn choose_layout(
             }
         }
     }
+    cands.retain(|(name, _, _)| !excluded.iter().any(|e| e == name));
     let predictions: Vec<_> = cands
         .par_iter()
         .map(|(_, _, d)| crate::predict::predict_mesh(d, size))
