@@ -548,25 +548,38 @@ impl Mesher {
         // fallback: a mesh of an automatically chosen layout with cells left folded (a block
         // whose transfinite start no untangling can fix, e.g. a side notched deeper than its
         // cells) is re-made from the next candidate layout, best predicted first, at most
-        // [`LAYOUT_FALLBACKS`] times; every attempt is named in the report's notes
+        // [`LAYOUT_FALLBACKS`] times; every attempt is named in the report's notes, and if none
+        // passes, the attempt with the fewest non-convex cells is the one reported
         let mut failed: Vec<String> = Vec::new();
-        while !allow && v.non_convex_cells > 0 && failed.len() < LAYOUT_FALLBACKS {
-            let Some(choice) = result.report.layout.as_ref() else {
+        // the layout and the folds of the last attempt (the kept one may be an earlier one)
+        let mut last = (
+            result.report.layout.as_ref().map(|c| c.layout.clone()),
+            v.non_convex_cells,
+        );
+        while !allow && !v.passed() && last.1 > 0 && failed.len() < LAYOUT_FALLBACKS {
+            let (Some(name), folds) = (last.0.take(), last.1) else {
                 break;
             };
             failed.push(format!(
-                "layout {} left {} non-convex cell(s); re-made from the next candidate layout",
-                choice.layout, v.non_convex_cells
+                "layout {name} left {folds} non-convex cell(s); re-made from the next candidate layout"
             ));
-            self.excluded_layouts.push(choice.layout.clone());
+            self.excluded_layouts.push(name);
             let retry = match self.mesh_unverified(region, observer) {
                 Ok(r) => r,
-                // no candidate left, or the next one fails in a stage: keep the first failure
+                // no candidate left, or the next one fails in a stage: keep what we have
                 Err(_) => break,
             };
             let rv = verify(&retry);
-            result = retry;
-            v = rv;
+            last = (
+                retry.report.layout.as_ref().map(|c| c.layout.clone()),
+                rv.non_convex_cells,
+            );
+            // keep the attempt with the fewest folds (the earlier on a tie); a passing retry
+            // always replaces a failing one
+            if rv.passed() || rv.non_convex_cells < v.non_convex_cells {
+                result = retry;
+                v = rv;
+            }
         }
         if !failed.is_empty() {
             result.report.seconds = t_start.elapsed().as_secs_f64();
