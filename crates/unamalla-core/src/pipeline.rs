@@ -560,9 +560,11 @@ impl Mesher {
             let (Some(name), folds) = (last.0.take(), last.1) else {
                 break;
             };
-            failed.push(format!(
+            let note = format!(
                 "layout {name} left {folds} non-convex cell(s); re-made from the next candidate layout"
-            ));
+            );
+            self.stage(Stage::Decompose, &note);
+            failed.push(note);
             self.excluded_layouts.push(name);
             let retry = match self.mesh_unverified(region, observer) {
                 Ok(r) => r,
