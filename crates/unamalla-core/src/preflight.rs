@@ -187,10 +187,7 @@ pub struct SmallHole {
 
 /// The width of `hole` for [`SmallHole`]: the smaller side of its bounding box.
 fn hole_width(hole: &unamalla_mesh::Polygon) -> (f64, DVec2) {
-    let (lo, hi) = hole.points().iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
+    let (lo, hi) = hole.bounding_box();
     let d = hi - lo;
     (d.x.min(d.y), 0.5 * (lo + hi))
 }
@@ -217,11 +214,8 @@ pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> O
                 .map(|(_, p)| vec![DVec2::new(p[0], p[1])]),
         )
         .collect();
-    let narrow: Vec<bool> = region
-        .holes()
-        .iter()
-        .map(|hole| hole_width(hole).0 < h)
-        .collect();
+    let widths: Vec<(f64, DVec2)> = region.holes().iter().map(hole_width).collect();
+    let narrow: Vec<bool> = widths.iter().map(|w| w.0 < h).collect();
     let mut count = vec![0usize; region.holes().len()];
     for pts in &cells {
         let nearest = region
@@ -253,7 +247,7 @@ pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> O
     if cells == 0 {
         return None;
     }
-    let (width, c) = hole_width(&region.holes()[hole]);
+    let (width, c) = widths[hole];
     Some(SmallHole {
         hole,
         width,
@@ -506,11 +500,6 @@ pub fn explain_failure(e: CoreError, region: &Region, h: f64) -> CoreError {
 /// narrower than the cell size, that hole ([`PreflightError::SmallHole`], [`small_hole`]);
 /// otherwise `e` unchanged.
 pub fn explain_guarantee(e: crate::verify::GuaranteeNotMet, region: &Region, h: f64) -> CoreError {
-    if let Some(s) = small_hole(&e.0, region, h) {
-        if !ring_gaps(region).is_some_and(|(_, _, gap)| gap < MIN_GAP_FRACTION * h) {
-            return CoreError::Preflight(PreflightError::SmallHole(Box::new(s)));
-        }
-    }
     match ring_gaps(region) {
         Some((a, b, gap)) if h > 0.0 && gap < MIN_GAP_FRACTION * h => {
             CoreError::Preflight(PreflightError::NarrowGap {
@@ -522,7 +511,10 @@ pub fn explain_guarantee(e: crate::verify::GuaranteeNotMet, region: &Region, h: 
                 detail: e.0.to_string(),
             })
         }
-        _ => CoreError::Guarantee(e),
+        _ => match small_hole(&e.0, region, h) {
+            Some(s) => CoreError::Preflight(PreflightError::SmallHole(Box::new(s))),
+            None => CoreError::Guarantee(e),
+        },
     }
 }
 

@@ -246,10 +246,10 @@ pub fn verify_quads<M: HasQuadCells>(
                 v.outside_examples.push((c, [centroid.x, centroid.y]));
             }
         }
-        // the signed area from the diagonals, `½ (p₂ − p₀) × (p₃ − p₁)` (the shoelace sum of
-        // the corner coordinates themselves cancels catastrophically far from the origin: at
-        // 10⁹ its terms are 10¹⁸ for cells of unit area)
-        area += 0.5 * (p[2] - p[0]).perp_dot(p[3] - p[1]);
+        // the fan from the first corner (`signed_area`, as the pipeline's report computes it):
+        // the shoelace sum of the corner coordinates themselves cancels catastrophically far
+        // from the origin (at 10⁹ its terms are 10¹⁸ for cells of unit area)
+        area += unamalla_mesh::region::signed_area(&p);
     }
     let ra = region.area();
     v.centroids_outside = Some(outside);

@@ -75,6 +75,10 @@ impl Polygon {
     pub fn area(&self) -> f64 {
         self.signed_area().abs()
     }
+    /// Axis-aligned bounding box `(min, max)` of the ring.
+    pub fn bounding_box(&self) -> (DVec2, DVec2) {
+        bbox(&self.points)
+    }
     /// Perimeter.
     pub fn perimeter(&self) -> f64 {
         let n = self.points.len();

@@ -266,12 +266,9 @@ pub struct Session<'o> {
     mask: Vec<bool>,
     group: usize,
     meas: Vec<f64>,
-    /// Scratch of [`crossing_times`](Self::crossing_times): the measures at `x ± d` and the
-    /// point `x ± d` (kept between calls: the fraction-to-the-boundary test runs up to six
-    /// times per iteration on ~10⁵ elements).
-    scratch_plus: Vec<f64>,
-    scratch_minus: Vec<f64>,
-    scratch_x: Vec<f64>,
+    /// Buffers of the fraction-to-the-boundary test ([`crossing_times`]), kept between
+    /// calls: it runs up to six times per iteration on ~10⁵ elements.
+    step: StepScratch,
     /// Absolute threshold of the safeguard (see the type docs).
     pub guard_threshold: f64,
     /// Whether the safeguard is on.
@@ -325,9 +322,7 @@ impl<'o> Session<'o> {
             mask,
             group: if problem.dim() == 3 { 10 } else { 4 },
             meas: a,
-            scratch_plus: Vec::new(),
-            scratch_minus: Vec::new(),
-            scratch_x: Vec::new(),
+            step: StepScratch::default(),
             guard_threshold: 0.0,
             guard: true,
             active_threshold: None,
@@ -465,99 +460,9 @@ impl<'o> Session<'o> {
         if problem.dim() != 2 {
             return f64::INFINITY;
         }
-        let mut a0 = std::mem::take(&mut self.meas);
-        problem.element_measures(x, &mut a0);
-        let mut times = Vec::new();
-        self.crossing_times(problem, x, &a0, d, horizon, &mut times);
-        self.meas = a0;
-        times.into_iter().fold(f64::INFINITY, f64::min)
-    }
-
-    /// Per element, the first `t > 0` at which its measure reaches the threshold along
-    /// `x + t·d` (`+∞` if never, for unmasked elements, for elements already at or below the
-    /// threshold, and possibly for crossings at or beyond `horizon`: see
-    /// [`max_step_within`](Self::max_step_within)); 2D only (see
-    /// [`max_step`](Self::max_step)). `a0` holds the measures at `x`
-    /// (computed once by the caller: [`hold_back`](Self::hold_back) asks for the times of up
-    /// to five directions from the same `x`).
-    ///
-    /// The measure is `α(t) = a·t² + b·t + c₀` with `b = (α(1) − α(−1))/2`,
-    /// `a = (α(1) + α(−1))/2 − α(0)`; the root of `α(t) = thr` is taken in the cancellation-free
-    /// form `q = −(b + sign(b)·√(b² − 4ac))/2`, roots `q/a` and `c/q` (`c = α(0) − thr`). The
-    /// elements are independent, so the loop runs in parallel; every time is computed by the
-    /// same arithmetic whatever the thread count.
-    fn crossing_times<P: Problem + ?Sized>(
-        &mut self,
-        problem: &P,
-        x: &[f64],
-        a0: &[f64],
-        d: &[f64],
-        horizon: f64,
-        out: &mut Vec<f64>,
-    ) {
-        use rayon::prelude::*;
-        let ne = a0.len();
-        out.clear();
-        out.resize(ne, f64::INFINITY);
-        let mut ap = std::mem::take(&mut self.scratch_plus);
-        let mut am = std::mem::take(&mut self.scratch_minus);
-        let mut xt = std::mem::take(&mut self.scratch_x);
-        ap.resize(ne, 0.0);
-        am.resize(ne, 0.0);
-        xt.clear();
-        xt.extend(x.iter().zip(d).map(|(a, b)| a + b));
-        problem.element_measures(&xt, &mut ap);
-        xt.iter_mut()
-            .zip(x.iter().zip(d))
-            .for_each(|(t, (a, b))| *t = a - b);
-        problem.element_measures(&xt, &mut am);
+        self.step.measure_start(problem, x);
         let thr = self.threshold();
-        let mask = &self.mask;
-        out.par_iter_mut()
-            .enumerate()
-            .with_min_len(4096)
-            .for_each(|(i, t_out)| {
-                if !mask[i] {
-                    return;
-                }
-                let c = a0[i] - thr;
-                if c <= 0.0 {
-                    return;
-                }
-                let b = 0.5 * (ap[i] - am[i]);
-                let a = 0.5 * (ap[i] + am[i]) - a0[i];
-                // |α(t) − α(0)| ≤ |b|·h + |a|·h² on [0, h]: no crossing before the horizon
-                // (with a relative margin far above the rounding of the root below)
-                let reach = b.abs() * horizon + a.abs() * horizon * horizon;
-                if c > reach * (1.0 + 1e-9) {
-                    return;
-                }
-                *t_out = if a.abs() <= 1e-14 * (b.abs() + c) {
-                    if b < 0.0 {
-                        -c / b
-                    } else {
-                        f64::INFINITY
-                    }
-                } else {
-                    let disc = b * b - 4.0 * a * c;
-                    if disc < 0.0 {
-                        f64::INFINITY
-                    } else {
-                        let q = -0.5 * (b + b.signum() * disc.sqrt());
-                        let (r1, r2) = (q / a, c / q);
-                        let mut r = f64::INFINITY;
-                        for v in [r1, r2] {
-                            if v > 0.0 && v < r {
-                                r = v;
-                            }
-                        }
-                        r
-                    }
-                };
-            });
-        self.scratch_plus = ap;
-        self.scratch_minus = am;
-        self.scratch_x = xt;
+        crossing_times(&mut self.step, problem, x, d, &self.mask, thr, horizon)
     }
 
     /// Holds back the nodes that block the step `d` from `x`: the direction components of
@@ -583,17 +488,16 @@ impl<'o> Session<'o> {
         if dim != 2 {
             return f64::INFINITY;
         }
-        let mut times = Vec::new();
         let mut nodes = Vec::new();
-        let mut a0 = std::mem::take(&mut self.meas);
-        problem.element_measures(x, &mut a0);
+        self.step.measure_start(problem, x);
+        let thr = self.threshold();
         // only crossings before `reach` are held back, and the caller compares the returned
         // step with 1
         let horizon = reach.max(1.0);
         for _ in 0..4 {
-            self.crossing_times(problem, x, &a0, d, horizon, &mut times);
+            let t_min = crossing_times(&mut self.step, problem, x, d, &self.mask, thr, horizon);
             let mut moved = 0usize;
-            for (e, &t) in times.iter().enumerate() {
+            for (e, &t) in self.step.times.iter().enumerate() {
                 if t >= reach {
                     continue;
                 }
@@ -611,13 +515,10 @@ impl<'o> Session<'o> {
                 }
             }
             if moved == 0 {
-                self.meas = a0;
-                return times.into_iter().fold(f64::INFINITY, f64::min);
+                return t_min;
             }
         }
-        self.crossing_times(problem, x, &a0, d, horizon, &mut times);
-        self.meas = a0;
-        times.into_iter().fold(f64::INFINITY, f64::min)
+        crossing_times(&mut self.step, problem, x, d, &self.mask, thr, horizon)
     }
 
     /// Sets the phase of the following iterations.
@@ -713,4 +614,104 @@ impl<'o> Session<'o> {
         self.monitor.gnorm = gnorm;
         self.monitor.elapsed = self.start.elapsed();
     }
+}
+
+/// Buffers of the fraction-to-the-boundary test: the element measures at `x` (`a0`), at
+/// `x + d` and `x − d`, the point `x ± d`, and the crossing time of each element.
+#[derive(Debug, Default)]
+struct StepScratch {
+    a0: Vec<f64>,
+    plus: Vec<f64>,
+    minus: Vec<f64>,
+    x: Vec<f64>,
+    times: Vec<f64>,
+}
+
+impl StepScratch {
+    /// The measures at the start point `x`, computed once per [`Session::max_step_within`] or
+    /// [`Session::hold_back`] call (which asks for up to five directions from the same `x`).
+    fn measure_start<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64]) {
+        self.a0.resize(problem.num_elements(), 0.0);
+        problem.element_measures(x, &mut self.a0);
+    }
+}
+
+/// Per element, the first `t > 0` at which its measure reaches `thr` along `x + t·d`, into
+/// `s.times` (`+∞` if never, for unmasked elements, for elements already at or below `thr`,
+/// and possibly for crossings at or beyond `horizon`: see [`Session::max_step_within`]);
+/// returns their minimum. 2D only; `s.a0` holds the measures at `x`
+/// ([`StepScratch::measure_start`]).
+///
+/// The measure is `α(t) = a·t² + b·t + c₀` with `b = (α(1) − α(−1))/2`,
+/// `a = (α(1) + α(−1))/2 − α(0)`; the root of `α(t) = thr` is taken in the cancellation-free
+/// form `q = −(b + sign(b)·√(b² − 4ac))/2`, roots `q/a` and `c/q` (`c = α(0) − thr`). The
+/// elements are independent, so the loop runs in parallel; every time is computed by the
+/// same arithmetic whatever the thread count (and their minimum is exact).
+fn crossing_times<P: Problem + ?Sized>(
+    s: &mut StepScratch,
+    problem: &P,
+    x: &[f64],
+    d: &[f64],
+    mask: &[bool],
+    thr: f64,
+    horizon: f64,
+) -> f64 {
+    use rayon::prelude::*;
+    let ne = s.a0.len();
+    s.plus.resize(ne, 0.0);
+    s.minus.resize(ne, 0.0);
+    s.x.clear();
+    s.x.extend(x.iter().zip(d).map(|(a, b)| a + b));
+    problem.element_measures(&s.x, &mut s.plus);
+    s.x.iter_mut()
+        .zip(x.iter().zip(d))
+        .for_each(|(t, (a, b))| *t = a - b);
+    problem.element_measures(&s.x, &mut s.minus);
+    let (a0, ap, am) = (&s.a0, &s.plus, &s.minus);
+    s.times.clear();
+    s.times.resize(ne, f64::INFINITY);
+    s.times
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(4096)
+        .for_each(|(i, t_out)| {
+            if !mask[i] {
+                return;
+            }
+            let c = a0[i] - thr;
+            if c <= 0.0 {
+                return;
+            }
+            let b = 0.5 * (ap[i] - am[i]);
+            let a = 0.5 * (ap[i] + am[i]) - a0[i];
+            // |α(t) − α(0)| ≤ |b|·h + |a|·h² on [0, h]: no crossing before the horizon
+            // (with a relative margin far above the rounding of the root below)
+            let reach = b.abs() * horizon + a.abs() * horizon * horizon;
+            if c > reach * (1.0 + 1e-9) {
+                return;
+            }
+            *t_out = if a.abs() <= 1e-14 * (b.abs() + c) {
+                if b < 0.0 {
+                    -c / b
+                } else {
+                    f64::INFINITY
+                }
+            } else {
+                let disc = b * b - 4.0 * a * c;
+                if disc < 0.0 {
+                    f64::INFINITY
+                } else {
+                    let q = -0.5 * (b + b.signum() * disc.sqrt());
+                    let (r1, r2) = (q / a, c / q);
+                    let mut r = f64::INFINITY;
+                    for v in [r1, r2] {
+                        if v > 0.0 && v < r {
+                            r = v;
+                        }
+                    }
+                    r
+                }
+            };
+        });
+    s.times.iter().copied().fold(f64::INFINITY, f64::min)
 }
