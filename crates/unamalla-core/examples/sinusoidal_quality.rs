@@ -96,7 +96,14 @@ fn main() {
                 };
                 let rep = smooth_coarse_to_fine(&mut g, &co, &mut trace).expect("c2f");
                 for l in &rep.levels {
-                    eprintln!("  level {}x{}: {:?}", l.m, l.n, l.report.status);
+                    eprintln!(
+                        "  level {}x{}: {} iterations, {:.2} s, {:?}",
+                        l.m,
+                        l.n,
+                        l.report.iter_classic,
+                        l.report.elapsed.as_secs_f64(),
+                        l.report.status
+                    );
                 }
                 rep.fine().expect("a fine level").clone()
             }

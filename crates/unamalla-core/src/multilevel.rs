@@ -305,12 +305,17 @@ pub fn coarse_options(opts: &SmoothOptions) -> SmoothOptions {
 }
 
 /// The options of the fine run from a prolonged start: `opts` without its σ continuation (the
-/// coarse levels already ran it; the start is a smoothed mesh at the final σ).
+/// coarse levels already ran it; the start is a smoothed mesh at the final σ), and its
+/// convergence tests with the short window of a polish run ([`unamalla_optim::StopRules::polish`]:
+/// nested iteration leaves only the fine-scale error, which Newton removes in a few
+/// iterations).
 pub fn polish_options(opts: &SmoothOptions) -> SmoothOptions {
-    SmoothOptions {
+    let mut o = SmoothOptions {
         sigma_continuation: Vec::new(),
         ..opts.clone()
-    }
+    };
+    o.solver.stop = o.solver.stop.polish();
+    o
 }
 
 /// Non-convex cells of `mesh` with its nodes at `nodes`.

@@ -492,9 +492,9 @@ impl Mesher {
     /// centroids inside the meshed region, its area and hole count; the area against the input
     /// region within [`INPUT_AREA_TOLERANCE`] unless holes were dropped on purpose); a failure is
     /// [`CoreError::Guarantee`] unless [`Mesher::allow_non_convex`] was set. When the layout was
-    /// chosen automatically and the mesh has non-convex cells, the mesh is re-made from the next
-    /// candidate layouts (at most [`LAYOUT_FALLBACKS`] more runs; the report's notes name each
-    /// layout that failed).
+    /// chosen automatically and the mesh has non-convex cells or cells whose centroid lies outside
+    /// the region, the mesh is re-made from the next candidate layouts (at most
+    /// [`LAYOUT_FALLBACKS`] more runs; the report's notes name each layout that failed).
     pub fn mesh_observed(
         mut self,
         region: &Region,
@@ -547,21 +547,25 @@ impl Mesher {
         let mut v = verify(&result);
         // fallback: a mesh of an automatically chosen layout with cells left folded (a block
         // whose transfinite start no untangling can fix, e.g. a side notched deeper than its
-        // cells) is re-made from the next candidate layout, best predicted first, at most
+        // cells) or reaching out of the region (a boundary chord that skips a sharp reflex
+        // vertex next to a block corner, with the cell behind it thinner than the excursion) is
+        // re-made from the next candidate layout, best predicted first, at most
         // [`LAYOUT_FALLBACKS`] times; every attempt is named in the report's notes, and if none
-        // passes, the attempt with the fewest non-convex cells is the one reported
+        // passes, the attempt with the fewest such cells is the one reported
+        let bad_cells =
+            |v: &crate::verify::Verification| v.non_convex_cells + v.centroids_outside.unwrap_or(0);
         let mut failed: Vec<String> = Vec::new();
-        // the layout and the folds of the last attempt (the kept one may be an earlier one)
+        // the layout and the bad cells of the last attempt (the kept one may be an earlier one)
         let mut last = (
             result.report.layout.as_ref().map(|c| c.layout.clone()),
-            v.non_convex_cells,
+            bad_cells(&v),
         );
         while !allow && !v.passed() && last.1 > 0 && failed.len() < LAYOUT_FALLBACKS {
-            let (Some(name), folds) = (last.0.take(), last.1) else {
+            let (Some(name), bad) = (last.0.take(), last.1) else {
                 break;
             };
             let note = format!(
-                "layout {name} left {folds} non-convex cell(s); re-made from the next candidate layout"
+                "layout {name} left {bad} cell(s) non-convex or outside the region; re-made from the next candidate layout"
             );
             self.stage(Stage::Decompose, &note);
             failed.push(note);
@@ -574,11 +578,11 @@ impl Mesher {
             let rv = verify(&retry);
             last = (
                 retry.report.layout.as_ref().map(|c| c.layout.clone()),
-                rv.non_convex_cells,
+                bad_cells(&rv),
             );
-            // keep the attempt with the fewest folds (the earlier on a tie); a passing retry
+            // keep the attempt with the fewest bad cells (the earlier on a tie); a passing retry
             // always replaces a failing one
-            if rv.passed() || rv.non_convex_cells < v.non_convex_cells {
+            if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
                 result = retry;
                 v = rv;
             }
@@ -1023,7 +1027,7 @@ fn boundary_hausdorff(mesh: &BlockMesh2, region: &Region) -> f64 {
 }
 
 /// At most this many other candidate layouts are tried after the automatically chosen one
-/// left non-convex cells ([`Mesher::mesh_observed`]); each try is a whole run of the
+/// left non-convex cells or cells outside the region ([`Mesher::mesh_observed`]); each try is a whole run of the
 /// pipeline, so the work is bounded by `1 + LAYOUT_FALLBACKS` runs.
 pub const LAYOUT_FALLBACKS: usize = 2;
 

@@ -130,5 +130,6 @@ pub use linalg::Preconditioner;
 pub use monitor::{Control, Monitor, NullObserver, Observer, Phase, ProgressObserver};
 pub use solver::{
     minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions, StopRules,
+    POLISH_WINDOW,
 };
 pub use status::{LineSearchFailure, Status, StopReason};
