@@ -1027,8 +1027,8 @@ fn boundary_hausdorff(mesh: &BlockMesh2, region: &Region) -> f64 {
 }
 
 /// At most this many other candidate layouts are tried after the automatically chosen one
-/// left non-convex cells or cells outside the region ([`Mesher::mesh_observed`]); each try is a whole run of the
-/// pipeline, so the work is bounded by `1 + LAYOUT_FALLBACKS` runs.
+/// left non-convex cells or cells outside the region ([`Mesher::mesh_observed`]); each try is
+/// a whole run of the pipeline, so the work is bounded by `1 + LAYOUT_FALLBACKS` runs.
 pub const LAYOUT_FALLBACKS: usize = 2;
 
 /// Margin (share of cells) by which the chord layout's prediction must beat the concavity

@@ -96,8 +96,7 @@ impl AlphaStats {
                 sum += a;
                 min = min.min(a);
             }
-            // the convexity test of `QuadMetrics::convex`
-            if !alphas.iter().all(|&a| a > 0.0) {
+            if !super::quad::alphas_convex(&alphas) {
                 non_convex += 1;
             }
         }

@@ -75,5 +75,5 @@ pub use mesh::{
     quad_boundary_nodes, quad_cell_metrics, quad_metrics_per_cell, quad_node_valences, AlphaStats,
     InteriorValence, MuBands, MuHistogram, HIGH_QUALITY_FRACTION, MU_FAIR, MU_GOOD,
 };
-pub use quad::{corner_alphas, is_convex, mu, QuadMetrics};
+pub use quad::{alphas_convex, corner_alphas, is_convex, mu, QuadMetrics};
 pub use report::{CellKind, HexSummary, MetricSummary, QuadSummary, QualityReport, ReportOptions};

@@ -87,7 +87,14 @@ pub fn min_alpha(q: &[DVec2; 4]) -> f64 {
 /// (seed 001 digest §1; design brief "a cell is convex iff all four α > 0").
 #[inline]
 pub fn is_convex(q: &[DVec2; 4]) -> bool {
-    corner_alphas(q).iter().all(|&a| a > 0.0)
+    alphas_convex(&corner_alphas(q))
+}
+
+/// The convexity test of [`is_convex`] on corner α already computed ([`corner_alphas`]): all
+/// four positive (a NaN is not).
+#[inline]
+pub fn alphas_convex(alphas: &[f64; 4]) -> bool {
+    alphas.iter().all(|&a| a > 0.0)
 }
 
 /// The "rectangles 2015" quality measure μ (seed 000 digest §1.4, González):
@@ -423,7 +430,7 @@ impl QuadMetrics {
         let alphas = corner_alphas(q);
         Self {
             alphas,
-            convex: alphas.iter().all(|&a| a > 0.0),
+            convex: alphas_convex(&alphas),
             mu: mu(q),
             jacobian: jacobian(q),
             scaled_jacobian: scaled_jacobian(q),
