@@ -13,6 +13,17 @@
 //! non-zero at some sample (Schoenberg–Whitney); it is factored by nalgebra's dense Cholesky,
 //! and a failed factorization is reported as [`BsplineError::Fit`].
 //!
+//! **Fairing.** A ragged side (a coastline with a lagoon behind a barrier island, a spit) has
+//! no simple control polygon among its least-squares fits with few control points: the fit
+//! follows both shores of a narrow spike and the polygon crosses itself. The fit then adds a
+//! second-difference penalty on the control points (the P-spline of Eilers & Marx, 1996,
+//! "Flexible smoothing with B-splines and penalties", *Statistical Science* 11(2), eq. (7)):
+//! minimize `Σ_k |r_k|² + w Σ_{i=1}^{n−2} |P_{i−1} − 2P_i + P_{i+1}|²`, so the normal equations
+//! become `(NᵀN + w DᵀD) P = Nᵀ R − w Dᵀ d₀` (`d₀` the fixed ends' part of the differences).
+//! The weight is `w = λ · tr(NᵀN) / tr(DᵀD)` so that the dimensionless `λ` ([`Fairing`]) weighs
+//! the two terms alike at `λ = 1` whatever the sample count. As `λ → ∞` the interior control
+//! points tend to the minimizer of the penalty alone, equally spaced on the chord `q_0 q_K`.
+//!
 //! Parameters ([`FitParameters`]): chord length, Piegl & Tiller eq. (9.5), or centripetal,
 //! eq. (9.6) (Lee, 1989, "Choosing nodes in parametric curve interpolation"), both after the
 //! polyline is densified so that no segment is longer than `1/(4(n−2))` of its length (so that
@@ -32,6 +43,25 @@ pub enum FitParameters {
     /// `u_k − u_{k−1} ∝ |q_k − q_{k−1}|^{1/2}` (Piegl & Tiller 1997, eq. (9.6)).
     Centripetal,
 }
+
+/// The fairing weight `λ` of the second-difference penalty (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum Fairing {
+    /// This `λ ≥ 0` (0 is the plain least-squares fit).
+    Fixed(f64),
+    /// Per side, the smallest `λ` of [`FAIRING_LADDER`] reached by raising `λ` on the sides
+    /// whose fit makes the boundary control polygon invalid (a crossing, a reflex corner:
+    /// [`crate::BoundaryCurves::validate`]) until it is valid; used by
+    /// [`crate::BoundaryCurves::fit_ring`].
+    Auto,
+}
+
+/// The `λ` tried in turn by [`Fairing::Auto`]: 0, then `10^{-4}` to `10^{3}` by factors of
+/// `√10` (16 fits at most).
+pub const FAIRING_LADDER: [f64; 16] = [
+    0.0, 1e-4, 3.162e-4, 1e-3, 3.162e-3, 1e-2, 3.162e-2, 1e-1, 3.162e-1, 1.0, 3.162, 10.0, 31.62,
+    100.0, 316.2, 1000.0,
+];
 
 /// Residuals of a fit at its samples.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -96,12 +126,19 @@ pub fn densify(points: &[DVec2], max_len: f64) -> Vec<DVec2> {
 }
 
 /// Control points of the order-`order` curve on `knots` minimizing the squared residuals at the
-/// given `(u_k, q_k)`, the first and last control points fixed to `q_0` and `q_K` (module docs).
+/// given `(u_k, q_k)` plus `λ =` `fairing` times the second-difference penalty, the first and
+/// last control points fixed to `q_0` and `q_K` (module docs).
 pub fn fit_with_parameters(
     points: &[DVec2],
     params: &[f64],
     knots: &KnotVector,
+    fairing: f64,
 ) -> Result<Vec<DVec2>, BsplineError> {
+    if !(fairing >= 0.0 && fairing.is_finite()) {
+        return Err(BsplineError::Fit(format!(
+            "fairing weight {fairing} (need a finite λ ≥ 0)"
+        )));
+    }
     let n = knots.num_basis();
     let k = knots.order();
     if params.len() != points.len() || points.len() < 2 {
@@ -156,6 +193,36 @@ pub fn fit_with_parameters(
             }
         }
     }
+    if fairing > 0.0 {
+        // rows i = 1..n−2 of D: (1, −2, 1) on P_{i−1}, P_i, P_{i+1}; tr(DᵀD) = Σ_rows 6
+        let w = fairing * ata.trace() / (6 * ni) as f64;
+        let fixed = |j: usize| {
+            if j == 0 {
+                Some(q0)
+            } else if j == n - 1 {
+                Some(qk)
+            } else {
+                None
+            }
+        };
+        for row in 1..n - 1 {
+            let stencil = [(row - 1, 1.0), (row, -2.0), (row + 1, 1.0)];
+            for &(a, ca) in &stencil {
+                if fixed(a).is_some() {
+                    continue;
+                }
+                for &(b, cb) in &stencil {
+                    match fixed(b) {
+                        Some(p) => {
+                            rhs[(a - 1, 0)] -= w * ca * cb * p.x;
+                            rhs[(a - 1, 1)] -= w * ca * cb * p.y;
+                        }
+                        None => ata[(a - 1, b - 1)] += w * ca * cb,
+                    }
+                }
+            }
+        }
+    }
     let chol = ata.cholesky().ok_or_else(|| {
         BsplineError::Fit(format!(
             "the normal equations of {ni} interior control points are singular: some basis function is zero at every sample (too few samples for {n} control points)"
@@ -200,17 +267,19 @@ pub fn residuals(
 }
 
 /// The quadratic curve with `n ≥ 3` control points on the uniform knots (23) fitted to a
-/// polyline (densified, then parametrized by `kind`): its control points and residuals.
+/// polyline (densified, then parametrized by `kind`) with fairing weight `λ =` `fairing`:
+/// its control points and residuals.
 pub fn fit_polyline(
     polyline: &[DVec2],
     n: usize,
     kind: FitParameters,
+    fairing: f64,
 ) -> Result<(Vec<DVec2>, FitReport), BsplineError> {
     let knots = KnotVector::biquadratic(n)?;
     let len: f64 = polyline.windows(2).map(|w| w[1].distance(w[0])).sum();
     let pts = densify(polyline, len / (4.0 * (n.max(3) - 2) as f64));
     let u = parameters(&pts, kind)?;
-    let ctrl = fit_with_parameters(&pts, &u, &knots)?;
+    let ctrl = fit_with_parameters(&pts, &u, &knots, fairing)?;
     let rep = residuals(&pts, &u, &knots, &ctrl)?;
     Ok((ctrl, rep))
 }
@@ -239,7 +308,7 @@ mod tests {
             })
             .collect();
         let q: Vec<DVec2> = u.iter().map(|&t| curve.eval(t)).collect();
-        let got = fit_with_parameters(&q, &u, &knots).unwrap();
+        let got = fit_with_parameters(&q, &u, &knots, 0.0).unwrap();
         for (a, b) in got.iter().zip(&ctrl) {
             assert!(a.distance(*b) < 1e-9, "{a} vs {b}");
         }
@@ -253,7 +322,7 @@ mod tests {
         let (a, b) = (DVec2::new(1.0, -2.0), DVec2::new(4.0, 2.0));
         let q: Vec<DVec2> = (0..=40).map(|l| a.lerp(b, l as f64 / 40.0)).collect();
         let n = 7;
-        let (ctrl, rep) = fit_polyline(&q, n, FitParameters::ChordLength).unwrap();
+        let (ctrl, rep) = fit_polyline(&q, n, FitParameters::ChordLength, 0.0).unwrap();
         // knots (23) for n = 7: breakpoints l/5; Greville g_i = (t_{i+1} + t_{i+2})/2
         let g = [0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0];
         for (p, gi) in ctrl.iter().zip(g) {
@@ -278,10 +347,10 @@ mod tests {
             })
             .collect();
         for n in [4usize, 6, 10, 20] {
-            let (_, rep) = fit_polyline(&q, n, FitParameters::ChordLength).unwrap();
+            let (_, rep) = fit_polyline(&q, n, FitParameters::ChordLength, 0.0).unwrap();
             let bound = r * theta * theta / (8.0 * ((n - 2) * (n - 2)) as f64);
             assert!(rep.rms <= bound, "n = {n}: rms {} > bound {bound}", rep.rms);
-            let (_, rc) = fit_polyline(&q, n, FitParameters::Centripetal).unwrap();
+            let (_, rc) = fit_polyline(&q, n, FitParameters::Centripetal, 0.0).unwrap();
             assert!(
                 rc.rms <= bound,
                 "centripetal n = {n}: rms {} > {bound}",
@@ -290,11 +359,91 @@ mod tests {
         }
     }
 
+    /// Samples of a circle arc (radius 3, angle 2.5) equispaced in angle.
+    fn arc_samples() -> Vec<DVec2> {
+        (0..=200)
+            .map(|l| {
+                let p = 2.5 * l as f64 / 200.0;
+                DVec2::new(3.0 * p.cos(), 3.0 * p.sin())
+            })
+            .collect()
+    }
+
+    /// As λ → ∞ only the penalty counts: `Σ|Δ²P|² = 0` with fixed ends has the unique
+    /// minimizer `P_i = q_0 + i/(n−1)·(q_K − q_0)` (a linear sequence), whatever the samples.
+    #[test]
+    fn infinite_fairing_spaces_the_control_points_evenly_on_the_chord() {
+        let q = arc_samples();
+        let n = 9;
+        let (ctrl, _) = fit_polyline(&q, n, FitParameters::ChordLength, 1e12).unwrap();
+        let (a, b) = (q[0], q[q.len() - 1]);
+        for (i, p) in ctrl.iter().enumerate() {
+            let want = a.lerp(b, i as f64 / (n - 1) as f64);
+            assert!(p.distance(want) < 1e-6, "P_{i} = {p}, want {want}");
+        }
+    }
+
+    /// Penalized least squares: as λ grows the data term cannot decrease and the penalty
+    /// cannot increase (compare the optimality of each solution at the other's λ).
+    #[test]
+    fn more_fairing_fits_worse_and_bends_less() {
+        let q = arc_samples();
+        let n = 10;
+        let second_differences = |c: &[DVec2]| -> f64 {
+            c.windows(3)
+                .map(|w| (w[0] - 2.0 * w[1] + w[2]).length_squared())
+                .sum()
+        };
+        let mut last: Option<(f64, f64)> = None;
+        for &l in &FAIRING_LADDER {
+            let (ctrl, rep) = fit_polyline(&q, n, FitParameters::ChordLength, l).unwrap();
+            let (data, pen) = (rep.rms, second_differences(&ctrl));
+            if let Some((d0, p0)) = last {
+                assert!(data >= d0 - 1e-12, "λ = {l}: rms {data} < {d0}");
+                assert!(pen <= p0 + 1e-12, "λ = {l}: penalty {pen} > {p0}");
+            }
+            last = Some((data, pen));
+        }
+        // and the ladder does change the fit: at λ = 1000 the arc is visibly flattened
+        let (_, r0) = fit_polyline(&q, n, FitParameters::ChordLength, 0.0).unwrap();
+        let (_, r1) = fit_polyline(&q, n, FitParameters::ChordLength, 1000.0).unwrap();
+        assert!(r1.rms > 100.0 * r0.rms, "{} vs {}", r1.rms, r0.rms);
+    }
+
+    /// Both terms vanish in the direction normal to a straight segment, so a faired fit of
+    /// collinear samples stays on the line.
+    #[test]
+    fn fairing_keeps_a_line_straight() {
+        let (a, b) = (DVec2::new(1.0, -2.0), DVec2::new(4.0, 2.0));
+        let q: Vec<DVec2> = (0..=40).map(|l| a.lerp(b, l as f64 / 40.0)).collect();
+        let normal = (b - a).perp().normalize();
+        for l in [0.01, 1.0, 100.0] {
+            let (ctrl, _) = fit_polyline(&q, 7, FitParameters::Centripetal, l).unwrap();
+            for p in &ctrl {
+                assert!(
+                    (*p - a).dot(normal).abs() < 1e-12,
+                    "λ = {l}: {p} off the line"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_negative_or_nan_fairing_weight_is_a_typed_error() {
+        let knots = KnotVector::biquadratic(5).unwrap();
+        let q = arc_samples();
+        let u = parameters(&q, FitParameters::ChordLength).unwrap();
+        for l in [-1.0, f64::NAN, f64::INFINITY] {
+            let e = fit_with_parameters(&q, &u, &knots, l).unwrap_err();
+            assert!(matches!(e, BsplineError::Fit(_)), "{e}");
+        }
+    }
+
     #[test]
     fn too_few_samples_is_a_typed_error() {
         let knots = KnotVector::biquadratic(10).unwrap();
         let q = [DVec2::ZERO, DVec2::X, DVec2::ONE];
-        let e = fit_with_parameters(&q, &[0.0, 0.5, 1.0], &knots).unwrap_err();
+        let e = fit_with_parameters(&q, &[0.0, 0.5, 1.0], &knots, 0.0).unwrap_err();
         assert!(matches!(e, BsplineError::Fit(_)), "{e}");
         assert!(parameters(&[DVec2::ONE, DVec2::ONE], FitParameters::ChordLength).is_err());
     }

@@ -62,11 +62,11 @@ pub use certify::{
 };
 pub use curve::BSplineCurve;
 pub use error::BsplineError;
-pub use fit::{fit_polyline, FitParameters, FitReport};
+pub use fit::{fit_polyline, Fairing, FitParameters, FitReport, FAIRING_LADDER};
 pub use interior::{optimize_interior, InteriorOptions, InteriorReport};
 pub use knots::KnotVector;
 pub use map::{Degree, TensorMap};
-pub use net::{BoundaryCurves, ControlNet, NetConvexity};
+pub use net::{BoundaryCurves, ControlNet, NetConvexity, RingFit};
 pub use sample::{sample_det_j, JacobianSample};
 
 /// Options of [`parametrize`].

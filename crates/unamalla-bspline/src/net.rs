@@ -393,19 +393,39 @@ impl BoundaryCurves {
     }
 }
 
+/// Names of the four sides in the order of [`RingFit`]'s arrays.
+pub const SIDE_NAMES: [&str; 4] = ["south", "east", "north", "west"];
+
+/// The result of [`BoundaryCurves::fit_ring`].
+#[derive(Debug, Clone)]
+pub struct RingFit {
+    /// The fitted boundary curves.
+    pub curves: BoundaryCurves,
+    /// Fit residuals of the south, east, north and west sides.
+    pub residuals: [crate::fit::FitReport; 4],
+    /// The fairing weight `λ` used on the south, east, north and west sides.
+    pub fairing: [f64; 4],
+}
+
 impl BoundaryCurves {
     /// Option (b) of the boundary preparation: a counter-clockwise ring split at four corner
     /// indices (as [`BoundaryCurves::from_ring`]), each side **fitted** by least squares
     /// ([`crate::fit::fit_polyline`]: quadratic, uniform knots (23)/(24), end points fixed to
     /// the corners; Piegl & Tiller 1997, §9.4.1) with `n` (south/north) or `m` (west/east)
-    /// control points. Returns the curves and the fit residuals of south, east, north, west.
+    /// control points and the fairing weight `fairing` (a fixed `λ`, or [`crate::fit::Fairing::Auto`]:
+    /// every side starts at `λ = 0`, and while [`BoundaryCurves::validate`] fails, the sides
+    /// its error names — the two sides of a crossing, the two at a reflex corner — go one step
+    /// up [`crate::fit::FAIRING_LADDER`], so a ragged side is faired without smoothing the
+    /// others; at most `4 × 16` fits). Returns the curves, their residuals and the `λ` of each
+    /// side.
     pub fn fit_ring(
         ring: &[DVec2],
         corners: [usize; 4],
         n: usize,
         m: usize,
         kind: crate::fit::FitParameters,
-    ) -> Result<(Self, [crate::fit::FitReport; 4]), BsplineError> {
+        fairing: crate::fit::Fairing,
+    ) -> Result<RingFit, BsplineError> {
         // the sides as dense polylines: every ring vertex of the side is kept
         let len = ring.len();
         if corners.iter().any(|&c| c >= len) {
@@ -414,29 +434,158 @@ impl BoundaryCurves {
             )));
         }
         let arc = |a: usize, b: usize| unamalla_mesh::tfi::ring_arc(ring, a, b);
-        let (south, rs) = crate::fit::fit_polyline(&arc(corners[0], corners[1]), n, kind)?;
-        let (east, re) = crate::fit::fit_polyline(&arc(corners[1], corners[2]), m, kind)?;
         let mut top = arc(corners[2], corners[3]);
         top.reverse();
-        let (north, rn) = crate::fit::fit_polyline(&top, n, kind)?;
         let mut left = arc(corners[3], corners[0]);
         left.reverse();
-        let (west, rw) = crate::fit::fit_polyline(&left, m, kind)?;
-        Ok((
-            Self {
-                south,
-                east,
-                north,
-                west,
+        let sides = [
+            (arc(corners[0], corners[1]), n),
+            (arc(corners[1], corners[2]), m),
+            (top, n),
+            (left, m),
+        ];
+        let fit_sides = |lambda: [f64; 4]| -> Result<RingFit, BsplineError> {
+            let fit = |s: usize| crate::fit::fit_polyline(&sides[s].0, sides[s].1, kind, lambda[s]);
+            let [(south, rs), (east, re), (north, rn), (west, rw)] =
+                [fit(0)?, fit(1)?, fit(2)?, fit(3)?];
+            Ok(RingFit {
+                curves: Self {
+                    south,
+                    east,
+                    north,
+                    west,
+                },
+                residuals: [rs, re, rn, rw],
+                fairing: lambda,
+            })
+        };
+        let ladder = &crate::fit::FAIRING_LADDER;
+        match fairing {
+            crate::fit::Fairing::Fixed(lambda) => fit_sides([lambda; 4]),
+            crate::fit::Fairing::Auto => {
+                // raise λ one ladder step on the sides the failed check names, until valid
+                let mut level = [0usize; 4];
+                loop {
+                    let f = fit_sides(level.map(|l| ladder[l]))?;
+                    let e = match f.curves.validate() {
+                        Ok(()) => return Ok(f),
+                        Err(e) => e,
+                    };
+                    let Some(named) = f.curves.sides_named_by(&e) else {
+                        return Err(e);
+                    };
+                    for (s, l) in level.iter_mut().enumerate() {
+                        if named[s] {
+                            if *l + 1 == ladder.len() {
+                                return Err(BsplineError::Fit(format!(
+                                    "no fairing weight up to λ = {} on the {} side gives a valid boundary control polygon (there: {e})",
+                                    ladder[*l],
+                                    SIDE_NAMES[s]
+                                )));
+                            }
+                            *l += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The sides (south, east, north, west) a failed [`BoundaryCurves::validate`] names:
+    /// the two sides of a crossing of the control polygon, the two sides meeting at a reflex
+    /// corner, all four for a clockwise polygon; `None` for errors fairing cannot mend (counts,
+    /// non-finite points, corner mismatch).
+    fn sides_named_by(&self, e: &BsplineError) -> Option<[bool; 4]> {
+        let (n, m) = (self.n(), self.m());
+        // edge k of `polygon()` runs from vertex k to k + 1
+        let side_of_edge = |k: usize| {
+            if k + 1 < n {
+                0
+            } else if k + 2 < n + m {
+                1
+            } else if k + 3 < 2 * n + m {
+                2
+            } else {
+                3
+            }
+        };
+        let mut named = [false; 4];
+        match e {
+            BsplineError::Clockwise { .. } => named = [true; 4],
+            BsplineError::ReflexCorner { corner, .. } => {
+                let (a, b) = match corner {
+                    'Q' => (3, 0),
+                    'R' => (0, 1),
+                    'S' => (1, 2),
+                    _ => (2, 3),
+                };
+                named[a] = true;
+                named[b] = true;
+            }
+            BsplineError::NotSimple(_) => match Polygon::new(self.polygon()) {
+                Err(unamalla_mesh::GeometryError::SelfIntersection { edge_a, edge_b, .. }) => {
+                    named[side_of_edge(edge_a)] = true;
+                    named[side_of_edge(edge_b)] = true;
+                }
+                _ => named = [true; 4],
             },
-            [rs, re, rn, rw],
-        ))
+            _ => return None,
+        }
+        Some(named)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 10 × 10 square whose east side has a slit 6 long and 0.1 wide (a lagoon behind a
+    /// barrier island): counter-clockwise ring and the corner indices of the square.
+    fn square_with_a_slit() -> (Vec<DVec2>, [usize; 4]) {
+        let mut ring = vec![DVec2::new(0.0, 0.0), DVec2::new(10.0, 0.0)];
+        for y in [4.95, 5.05] {
+            let tip = DVec2::new(4.0, y);
+            if y < 5.0 {
+                ring.extend([DVec2::new(10.0, y), tip]);
+            } else {
+                ring.extend([tip, DVec2::new(10.0, y)]);
+            }
+        }
+        let r = ring.len();
+        ring.extend([DVec2::new(10.0, 10.0), DVec2::new(0.0, 10.0)]);
+        (ring, [0, 1, r, r + 1])
+    }
+
+    #[test]
+    fn auto_fairing_smooths_only_the_ragged_side() {
+        let (ring, corners) = square_with_a_slit();
+        let (n, m) = (6, 8);
+        let kind = crate::fit::FitParameters::ChordLength;
+        // the plain least-squares east curve follows the slit and the polygon is invalid
+        let plain =
+            BoundaryCurves::fit_ring(&ring, corners, n, m, kind, crate::fit::Fairing::Fixed(0.0))
+                .unwrap();
+        assert!(plain.curves.validate().is_err());
+        let auto = BoundaryCurves::fit_ring(&ring, corners, n, m, kind, crate::fit::Fairing::Auto)
+            .unwrap();
+        auto.curves.validate().unwrap();
+        // straight sides are fitted exactly at λ = 0; only the east side is faired
+        assert_eq!(auto.fairing[0], 0.0);
+        assert_eq!(auto.fairing[2], 0.0);
+        assert_eq!(auto.fairing[3], 0.0);
+        assert!(auto.fairing[1] > 0.0, "{:?}", auto.fairing);
+        for s in [0, 2, 3] {
+            assert!(auto.residuals[s].max < 1e-9, "{}", SIDE_NAMES[s]);
+        }
+        // the faired east side cuts across the slit: it misses the slit's tip by about its
+        // depth (6) at most, and the curves are a valid net boundary
+        assert!(
+            auto.residuals[1].max <= 6.0 + 1e-9,
+            "{:?}",
+            auto.residuals[1]
+        );
+        ControlNet::from_boundary(&auto.curves).unwrap();
+    }
 
     #[test]
     fn triangle_labels_match_edge_determinants() {

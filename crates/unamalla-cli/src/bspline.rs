@@ -27,7 +27,7 @@ use anyhow::{bail, Context, Result};
 use serde_json::{json, Value};
 use unamalla_core::bspline::{
     certify_map, export, optimize_interior, BernsteinOutcome, BoundaryCurves, Certificates,
-    ControlNet, Degree, FitParameters, InteriorOptions, TensorMap,
+    ControlNet, Degree, Fairing, FitParameters, InteriorOptions, TensorMap,
 };
 use unamalla_core::bspline_maps::{block_maps, BlockMapOptions};
 use unamalla_core::io;
@@ -57,6 +57,12 @@ pub struct BsplineArgs {
     /// self-intersects.
     #[arg(long, value_parser = ["chord-length", "centripetal"], conflicts_with = "blocks")]
     pub fit: Option<String>,
+    /// With --fit: the weight λ of the fit's second-difference (fairing) penalty on every
+    /// side, or `auto`: λ starts at 0 and goes up the ladder 1e-4, 3.2e-4, …, 1000 on the sides
+    /// whose curves make the control polygon cross itself or a corner reflex, until it is
+    /// valid (report.json `boundary_fit.fairing`: λ of south, east, north, west).
+    #[arg(long, default_value = "auto", requires = "fit", value_parser = parse_fairing)]
+    pub fairing: Fairing,
     /// One map per block of the pipeline's block-structured mesh instead of one net.
     #[arg(long)]
     pub blocks: bool,
@@ -98,6 +104,16 @@ fn parse_net(s: &str) -> Result<(usize, usize), String> {
         ));
     }
     Ok((n, m))
+}
+
+fn parse_fairing(s: &str) -> Result<Fairing, String> {
+    if s.eq_ignore_ascii_case("auto") {
+        return Ok(Fairing::Auto);
+    }
+    match s.trim().parse::<f64>() {
+        Ok(l) if l >= 0.0 && l.is_finite() => Ok(Fairing::Fixed(l)),
+        _ => Err(format!("expected `auto` or a finite λ ≥ 0, got '{s}'")),
+    }
 }
 
 fn write_with(
@@ -268,8 +284,9 @@ pub fn run(a: BsplineArgs) -> Result<()> {
                 } else {
                     FitParameters::ChordLength
                 };
-                let (b, r) = BoundaryCurves::fit_ring(region.outer().points(), c, n, m, kind)?;
-                (b, Some((kind, r)))
+                let f =
+                    BoundaryCurves::fit_ring(region.outer().points(), c, n, m, kind, a.fairing)?;
+                (f.curves, Some((kind, f.residuals, f.fairing)))
             }
         };
         let mut net = ControlNet::from_boundary(&boundary)?;
@@ -297,7 +314,7 @@ pub fn run(a: BsplineArgs) -> Result<()> {
             "degree": a.degree,
             "net": [n, m],
             "corners_ring_indices": c,
-            "boundary_fit": fit_report.map(|(k, r)| json!({"parameters": k, "south": r[0], "east": r[1], "north": r[2], "west": r[3]})),
+            "boundary_fit": fit_report.map(|(k, r, lambda)| json!({"parameters": k, "fairing": lambda, "south": r[0], "east": r[1], "north": r[2], "west": r[3]})),
             "samples": a.samples,
             "min_det_j": s.min,
             "min_det_j_at": [s.argmin.0, s.argmin.1],

@@ -135,6 +135,81 @@ fn blocks_of_a_region_with_a_hole() {
     assert!(out.join("block-0-isocurves.vtk").is_file());
 }
 
+/// Texas as one biquadratic map: the resampled sides give a self-intersecting control polygon
+/// (the Laguna Madre behind Padre Island is a slit on the east side); the least-squares fit
+/// with automatic fairing gives a valid one, faired on the east side only, and a map with
+/// det J > 0 (Bernstein certificate). The mean of det J over the unit square is the area of
+/// the image, checked against the shoelace area of the region's ring.
+#[test]
+fn texas_biquadratic_with_a_faired_least_squares_boundary() {
+    let dir = tmpdir("texas");
+    let region = fixture("texas.geojson");
+    let args = [
+        "--degree",
+        "2",
+        "--net",
+        "35x35",
+        "--samples",
+        "500",
+        "--quiet",
+    ];
+    let out0 = dir.join("plain");
+    let st = bin()
+        .arg("bspline")
+        .arg(&region)
+        .args(args)
+        .arg("-o")
+        .arg(&out0)
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(err.contains("not simple"), "{err}");
+
+    let out = dir.join("fit");
+    bin()
+        .arg("bspline")
+        .arg(&region)
+        .args(args)
+        .args(["--fit", "chord-length", "-o"])
+        .arg(&out)
+        .run_ok();
+    let v = report(&out);
+    assert!(v["min_det_j"].as_f64().unwrap() > 0.0, "{v}");
+    assert_eq!(v["bernstein"]["outcome"], "certified", "{v}");
+    assert_eq!(v["nonpositive_samples"], 0);
+    let fit = &v["boundary_fit"];
+    let lambda: Vec<f64> = fit["fairing"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(lambda[1] > 0.0, "{fit}");
+    assert!(lambda.iter().filter(|&&l| l == 0.0).count() >= 2, "{fit}");
+    // the region's area by the shoelace formula on the file's ring
+    let gj: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&region).unwrap()).unwrap();
+    let ring = gj["features"][0]["geometry"]["coordinates"][0]
+        .as_array()
+        .unwrap();
+    let p: Vec<(f64, f64)> = ring
+        .iter()
+        .map(|c| (c[0].as_f64().unwrap(), c[1].as_f64().unwrap()))
+        .collect();
+    let area = p
+        .windows(2)
+        .map(|w| w[0].0 * w[1].1 - w[1].0 * w[0].1)
+        .sum::<f64>()
+        .abs()
+        / 2.0;
+    let mean = v["mean_det_j"].as_f64().unwrap();
+    assert!(
+        (mean / area - 1.0).abs() < 0.02,
+        "mean det J {mean} vs area {area}"
+    );
+}
+
 #[test]
 fn bad_input_gives_one_error_line_and_no_files() {
     let dir = tmpdir("bad");
