@@ -26,8 +26,8 @@
 //!    when `A` is, since `P` has full column rank).
 //!
 //! Coarsening stops at [`MultigridOptions::coarse_size`] unknowns, where the coarsest operator
-//! is factored by a dense Cholesky decomposition (with a small diagonal shift if it is not
-//! numerically positive definite).
+//! is factored by a dense Cholesky decomposition (nalgebra's `Cholesky`, with a small diagonal
+//! shift if it is not numerically positive definite).
 //!
 //! **V-cycle** `z = M⁻¹ r` (`ν` = [`MultigridOptions::sweeps`]): `ν` damped block-Jacobi sweeps
 //! `x ← x + ω_s D⁻¹(b − A x)` from `x = 0`, restriction `b_c = Pᵀ(b − A x)`, recursive coarse
@@ -42,6 +42,7 @@
 //! the finest level (≈ 2–4 fine matrix-vector products); one V-cycle costs ≈ `2ν + 2` fine
 //! matrix-vector products.
 
+use nalgebra::{Cholesky, DMatrix, DVectorViewMut, Dyn};
 use rayon::prelude::*;
 use unamalla_functionals::Csr;
 
@@ -117,8 +118,8 @@ pub struct Multigrid {
     levels: Vec<Level>,
     /// Coarsest operator (level `levels.len()`), kept for diagnostics.
     coarse_n: usize,
-    /// Dense lower Cholesky factor of the coarsest operator (row-major, `coarse_n²`).
-    chol: Vec<f64>,
+    /// Cholesky factorization of the coarsest operator (`coarse_n × coarse_n`).
+    chol: Cholesky<f64, Dyn>,
     /// Unknowns per level (finest first).
     sizes: Vec<usize>,
     /// Stored entries per level (finest first).
@@ -254,7 +255,9 @@ impl Multigrid {
 
     fn vcycle(&self, l: usize, a_fine: &Csr, b: &[f64], x: &mut [f64]) {
         if l == self.levels.len() {
-            cholesky_solve(&self.chol, self.coarse_n, b, x);
+            x.copy_from_slice(b);
+            self.chol
+                .solve_mut(&mut DVectorViewMut::from_slice(x, self.coarse_n));
             return;
         }
         let lev = &self.levels[l];
@@ -637,31 +640,32 @@ pub(crate) fn spgemm(a: &Csr, b: &Csr) -> Csr {
     }
 }
 
-/// Dense Cholesky factor `L` (row-major, lower) of the symmetric part of `a`; if `a` is not
-/// numerically positive definite, a diagonal shift `δ·max|a_ii|` (δ = 1e-12, ×10 until the
-/// factorization succeeds) is added, so the coarse solve is always SPD.
-fn dense_cholesky_shifted(a: &Csr) -> Vec<f64> {
+/// Dense Cholesky factorization (nalgebra's `Cholesky`, `A = L Lᵀ`) of the symmetric part of
+/// `a`; if `a` is not numerically positive definite, a diagonal shift `δ·max|a_ii|` (δ = 1e-12,
+/// ×10 until the factorization succeeds) is added, so the coarse solve is always SPD.
+fn dense_cholesky_shifted(a: &Csr) -> Cholesky<f64, Dyn> {
     let n = a.nrows;
-    let mut dense = vec![0.0; n * n];
+    let mut dense = DMatrix::<f64>::zeros(n, n);
     for r in 0..n {
         for e in a.row_offsets[r]..a.row_offsets[r + 1] {
             let c = a.col_indices[e] as usize;
-            dense[r * n + c] += 0.5 * a.values[e];
-            dense[c * n + r] += 0.5 * a.values[e];
+            dense[(r, c)] += 0.5 * a.values[e];
+            dense[(c, r)] += 0.5 * a.values[e];
         }
     }
     let dmax = (0..n)
-        .map(|i| dense[i * n + i].abs())
+        .map(|i| dense[(i, i)].abs())
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
     let mut shift = 0.0;
     loop {
-        let mut l = dense.clone();
+        let mut m = dense.clone();
         for i in 0..n {
-            l[i * n + i] += shift;
+            m[(i, i)] += shift;
         }
-        if cholesky_in_place(&mut l, n) {
-            return l;
+        // `Cholesky::new` returns None when a pivot is not > 0 (or is NaN)
+        if let Some(c) = m.cholesky() {
+            return c;
         }
         shift = if shift == 0.0 {
             1e-12 * dmax
@@ -669,58 +673,10 @@ fn dense_cholesky_shifted(a: &Csr) -> Vec<f64> {
             shift * 10.0
         };
         if shift > 1e3 * dmax {
-            // hopeless (NaN entries): identity scaled by the largest diagonal entry
-            let mut l = vec![0.0; n * n];
-            for i in 0..n {
-                l[i * n + i] = dmax.sqrt();
-            }
-            return l;
+            // hopeless (NaN entries): the factor of the largest diagonal entry times I
+            let scaled = DMatrix::<f64>::from_diagonal_element(n, n, dmax);
+            return Cholesky::new_unchecked(scaled);
         }
-    }
-}
-
-/// In-place dense Cholesky (lower triangle of row-major `l`); false if a pivot is not > 0.
-fn cholesky_in_place(l: &mut [f64], n: usize) -> bool {
-    for j in 0..n {
-        let mut d = l[j * n + j];
-        for k in 0..j {
-            d -= l[j * n + k] * l[j * n + k];
-        }
-        if d.is_nan() || d <= 0.0 || !d.is_finite() {
-            return false;
-        }
-        let d = d.sqrt();
-        l[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = l[i * n + j];
-            for k in 0..j {
-                s -= l[i * n + k] * l[j * n + k];
-            }
-            l[i * n + j] = s / d;
-        }
-        for i in 0..j {
-            l[i * n + j] = 0.0;
-        }
-    }
-    true
-}
-
-/// Solves `L Lᵀ x = b`.
-fn cholesky_solve(l: &[f64], n: usize, b: &[f64], x: &mut [f64]) {
-    x.copy_from_slice(b);
-    for i in 0..n {
-        let mut s = x[i];
-        for k in 0..i {
-            s -= l[i * n + k] * x[k];
-        }
-        x[i] = s / l[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let mut s = x[i];
-        for k in i + 1..n {
-            s -= l[k * n + i] * x[k];
-        }
-        x[i] = s / l[i * n + i];
     }
 }
 
@@ -960,12 +916,21 @@ mod tests {
             ncols: 2,
             row_offsets: vec![0, 2, 4],
             col_indices: vec![0, 1, 0, 1],
-            values: vec![1.0, 2.0, 2.0, 1.0],
+            values: vec![1.0, 3.0, 3.0, 1.0],
         };
-        let l = dense_cholesky_shifted(&a);
-        assert!(l.iter().all(|v| v.is_finite()));
-        let mut x = [0.0; 2];
-        cholesky_solve(&l, 2, &[1.0, 1.0], &mut x);
-        assert!(x.iter().all(|v| v.is_finite()));
+        // eigenvalues 4 and −2, max|a_ii| = 1: the shifts 1e-12, 1e-11, …, 1 fail, 10 is the
+        // first with A + dI positive definite
+        let c = dense_cholesky_shifted(&a);
+        let l = c.l();
+        let shifted = &l * l.transpose();
+        let d = shifted[(0, 0)] - 1.0;
+        assert!((d - 10.0).abs() < 1e-9, "shift {d}");
+        assert!((shifted[(0, 1)] - 3.0).abs() < 1e-12);
+        let mut x = nalgebra::DVector::from_vec(vec![1.0, 1.0]);
+        c.solve_mut(&mut x);
+        // (A + dI) x = (1, 1), an eigenvector of A (eigenvalue 4): x = (1, 1)/(4 + d)
+        for v in x.iter() {
+            assert!((v - 1.0 / 14.0).abs() < 1e-12, "{v}");
+        }
     }
 }
