@@ -160,6 +160,18 @@ pub struct MeshArgs {
     /// does not depend on the machine.
     #[arg(long)]
     pub time_limit: Option<f64>,
+    /// Sweeps of the shape pass after the smoothing at most: cells below the target μ
+    /// (--shape-target) are improved one node at a time, the nodes on the region boundary
+    /// sliding along it; 0 turns the pass off.
+    #[arg(long, default_value_t = unamalla_core::optim::ShapeOptions::default().max_sweeps)]
+    pub shape_sweeps: usize,
+    /// The target μ of the shape pass: cells below it are raised where the guards allow.
+    #[arg(long, default_value_t = unamalla_core::optim::ShapeOptions::default().target)]
+    pub shape_target: f64,
+    /// Keep the nodes on the region boundary where the transfinite interpolation put them
+    /// (the shape pass moves interior nodes only).
+    #[arg(long)]
+    pub no_slide: bool,
     /// For a MultiPolygon: `all` (the default: every part is meshed, into `part-K/`
     /// subdirectories with a summary `report.json`) or one part's 0-based index.
     #[arg(long, value_parser = crate::reliability::parse_part)]
@@ -205,6 +217,12 @@ pub fn mesh(a: MeshArgs) -> Result<()> {
     }
     if !(a.neck_factor.is_finite() && a.neck_factor >= 0.0) {
         usage!("--neck-factor must be a number ≥ 0");
+    }
+    if !(a.shape_target > 0.0 && a.shape_target <= 1.0) {
+        usage!(
+            "--shape-target must be a number in (0, 1], got {}",
+            a.shape_target
+        );
     }
     if !matches!(a.strategy.as_str(), "cuts" | "submap" | "auto") {
         usage!(
@@ -316,6 +334,12 @@ fn mesh_part(
         }
     }
     mesher = mesher.time_limit(a.time_limit);
+    mesher = mesher.shape((a.shape_sweeps > 0).then(|| {
+        unamalla_core::optim::ShapeOptions::default()
+            .with_target(a.shape_target)
+            .with_max_sweeps(a.shape_sweeps)
+            .with_slide(!a.no_slide)
+    }));
     mesher = mesher.strategy(match a.strategy.as_str() {
         "submap" => Strategy::Submap,
         "auto" => Strategy::Auto,

@@ -11,7 +11,7 @@ use unamalla_core::optim::{Control, Monitor, Observer, ProgressObserver};
 use unamalla_core::pipeline::Stage;
 
 /// The number of pipeline stages ([`Stage`]).
-const STAGES: u64 = 7;
+const STAGES: u64 = 8;
 
 fn stage_index(s: Stage) -> u64 {
     match s {
@@ -21,7 +21,8 @@ fn stage_index(s: Stage) -> u64 {
         Stage::Tfi => 3,
         Stage::Merge => 4,
         Stage::Smooth => 5,
-        Stage::Report => 6,
+        Stage::Shape => 6,
+        Stage::Report => 7,
     }
 }
 

@@ -71,7 +71,9 @@ use unamalla_decompose::{
 use unamalla_mesh::quality::QualityReport;
 use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells, Region};
 use unamalla_optim::monitor::{NullObserver, Observer};
-use unamalla_optim::{smooth, SmoothOptions};
+use unamalla_optim::{
+    improve_shape, smooth, BoundarySlide, ShapeOptions, ShapeReport, SmoothOptions,
+};
 
 use crate::CoreError;
 
@@ -154,6 +156,8 @@ pub enum Stage {
     Merge,
     /// Smoothing.
     Smooth,
+    /// Local shape improvement with boundary sliding ([`unamalla_optim::shape`]).
+    Shape,
     /// Quality report.
     Report,
 }
@@ -186,6 +190,7 @@ pub struct Mesher {
     strategy: Strategy,
     allow_non_convex: bool,
     coarse_levels: usize,
+    shape: Option<ShapeOptions>,
     /// Candidate layouts [`choose_layout`] must not pick (set by the fallback of
     /// [`Mesher::mesh_observed`] after a layout failed the guarantee).
     excluded_layouts: Vec<String>,
@@ -252,6 +257,8 @@ pub struct MeshReport {
     pub holes_dropped: Vec<usize>,
     /// Smoother status message.
     pub smoothing: String,
+    /// What the shape pass after the smoothing did (`None` when it is off).
+    pub shape: Option<ShapeReport>,
     /// Total wall time in seconds (with a layout fallback of [`Mesher::mesh_observed`]: of
     /// every attempt; `stage_seconds` are those of the attempt kept).
     pub seconds: f64,
@@ -292,6 +299,7 @@ impl Mesher {
             strategy: Strategy::Cuts,
             allow_non_convex: false,
             coarse_levels: crate::multilevel::DEFAULT_COARSE_LEVELS,
+            shape: Some(ShapeOptions::default()),
             excluded_layouts: Vec::new(),
         }
     }
@@ -401,6 +409,13 @@ impl Mesher {
     /// requests; a prolonged start that is not convex is discarded.
     pub fn coarse_levels(mut self, levels: usize) -> Self {
         self.coarse_levels = levels;
+        self
+    }
+    /// The local shape pass after the smoothing ([`unamalla_optim::shape`]; default
+    /// [`ShapeOptions::default`]: cells below μ = 0.85 improved, region-boundary nodes sliding
+    /// along the boundary); `None` turns it off.
+    pub fn shape(mut self, opts: Option<ShapeOptions>) -> Self {
+        self.shape = opts;
         self
     }
     /// A progress callback called at the start of every stage.
@@ -810,6 +825,28 @@ impl Mesher {
         mesh.sync_blocks();
         lap(Stage::Smooth, &mut timer);
 
+        // 7c. local shape improvement, the region-boundary nodes sliding along the boundary
+        // ([`unamalla_optim::shape`]): the smoother keeps them where the transfinite
+        // interpolation put them, so rows of cells meeting the boundary obliquely stay sheared
+        let shape = match self.shape.clone() {
+            Some(o) if o.max_sweeps > 0 => {
+                self.stage(Stage::Shape, "shape pass (boundary nodes sliding)");
+                let slide = BoundarySlide::new(mesh.global(), &simplified, o.feature_angle_deg);
+                let r = improve_shape(mesh.global_mut(), Some(&slide), &o, observer);
+                mesh.sync_blocks();
+                self.stage(
+                    Stage::Shape,
+                    &format!(
+                        "shape pass: μ ≥ {} on {:.1} → {:.1} % of the cells ({} sweeps, {} moves, {} slides)",
+                        o.keep, r.good_before, r.good_after, r.sweeps, r.moved, r.slid
+                    ),
+                );
+                lap(Stage::Shape, &mut timer);
+                Some(r)
+            }
+            _ => None,
+        };
+
         // 8. report
         self.stage(Stage::Report, "quality report");
         let quality = QualityReport::for_quads(&mesh);
@@ -845,6 +882,7 @@ impl Mesher {
             hausdorff,
             holes_dropped,
             smoothing: smoothing.status.to_string(),
+            shape,
             seconds: t0.elapsed().as_secs_f64(),
             stage_seconds,
             block_quality: layout_choice

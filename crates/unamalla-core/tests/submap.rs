@@ -42,15 +42,38 @@ fn check_submap(name: &str, region: &Region, h: f64) -> MeshResult {
     }
     let euler = mesh.num_nodes() as i64 - edges.len() as i64 + mesh.num_quads() as i64;
     assert_eq!(euler, 1 - region.holes().len() as i64, "{name}: V − E + F");
-    // cut and virtual-edge nodes were free: they are interior nodes of the merged mesh (every
-    // such node position is now away from the region boundary or unchanged only by chance);
-    // boundary nodes stayed where the submapping put them
+    // every boundary node of the mesh lies on the region boundary (the shape pass slides
+    // them along it, it never takes them off)
     let global = mesh.global();
+    for (v, &fixed) in global.fixed().iter().enumerate() {
+        if fixed {
+            let p = global.nodes()[v];
+            let on = region.rings().any(|ring| {
+                let pts = ring.points();
+                (0..pts.len()).any(|i| {
+                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+                    p.distance(a + t * (b - a)) < 1e-9
+                })
+            });
+            assert!(on, "{name}: boundary node {p} is off the region boundary");
+        }
+    }
+    // without the shape pass, cut and virtual-edge nodes were free (interior nodes of the
+    // merged mesh) and boundary nodes stayed where the submapping put them
+    let fixed_run = Mesher::new()
+        .simplify(None)
+        .cell_size(h)
+        .strategy(Strategy::Submap)
+        .shape(None)
+        .mesh(region)
+        .unwrap();
+    let nodes = fixed_run.mesh.global().nodes();
     for (id, kind) in s.node_kinds.iter().enumerate() {
         if *kind == NodeKind::Boundary {
             let p = s.nodes[id];
             assert!(
-                global.nodes().iter().any(|q| q.distance(p) < 1e-9),
+                nodes.iter().any(|q| q.distance(p) < 1e-9),
                 "{name}: boundary node {p} moved"
             );
         }

@@ -116,6 +116,7 @@ pub mod linesearch;
 pub mod monitor;
 pub mod multigrid;
 pub mod psd_model;
+pub mod shape;
 pub mod solver;
 pub mod status;
 
@@ -128,6 +129,7 @@ pub use drivers::{
 pub use error::OptimError;
 pub use linalg::Preconditioner;
 pub use monitor::{Control, Monitor, NullObserver, Observer, Phase, ProgressObserver};
+pub use shape::{improve_shape, BoundarySlide, ShapeOptions, ShapeReport};
 pub use solver::{
     minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions, StopRules,
     POLISH_WINDOW,
