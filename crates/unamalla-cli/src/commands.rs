@@ -172,6 +172,11 @@ pub struct MeshArgs {
     /// (the shape pass moves interior nodes only).
     #[arg(long)]
     pub no_slide: bool,
+    /// Exit with code 3 (after writing everything) when the mesh misses a quality target:
+    /// μ ≥ 0.8 on fewer than 90 % of the cells, or (with --cells) a cell count more than 15 %
+    /// off the request.
+    #[arg(long)]
+    pub strict: bool,
     /// For a MultiPolygon: `all` (the default: every part is meshed, into `part-K/`
     /// subdirectories with a summary `report.json`) or one part's 0-based index.
     #[arg(long, value_parser = crate::reliability::parse_part)]
@@ -377,7 +382,17 @@ fn mesh_part(
     let result = result.with_context(|| format!("{name}: nothing written"))?;
     let mut report = result.report.clone();
     report.region = name.to_string();
-    let not_met = reliability::guarantee(&report.verification, true, name)?;
+    let mut not_met = reliability::guarantee(&report.verification, true, name)?;
+    if a.strict {
+        let missed = reliability::strict_targets(&report, a.cells);
+        if !missed.is_empty() {
+            let msg = format!("{name}: --strict: {}", missed.join("; "));
+            not_met = Some(match not_met {
+                Some(m) => format!("{m}; {msg}"),
+                None => msg,
+            });
+        }
+    }
 
     // everything computed: now write (into the staging directory)
     let mesh = &result.mesh;

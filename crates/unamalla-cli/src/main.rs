@@ -57,8 +57,10 @@ use unamalla_core::single_block::{tfi_region, Corners};
     version,
     about = "Structured and block-structured quad/hex meshes with convex cells",
     after_help = "Exit codes: 0 ok, 1 input error, 2 usage error (or a size above the memory limit, \
-                  UNAMALLA_MAX_MEMORY, default 4G), 3 the guarantee (convex cells inside the region) is not met, \
-                  4 other (writing failed, internal error)."
+                  UNAMALLA_MAX_MEMORY, default 4G), 3 the guarantee (convex cells inside the region) is not met \
+                  (or, with mesh --strict, a quality target is missed; the output is written), \
+                  4 other (writing failed, internal error). With --json an error is also printed on \
+                  stdout as one JSON object, {\"error\": {\"exit_code\", \"kind\", \"message\"}}."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -384,11 +386,42 @@ fn main() -> ExitCode {
             msg.replace('\n', " ")
         );
     }));
-    let cli = Cli::parse();
+    // `--json` anywhere: errors are also printed on stdout as one JSON object
+    // (`{"error": {"exit_code", "kind", "message"}}`), so a script reading stdout gets JSON
+    let json = std::env::args().any(|a| a == "--json");
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            let shows = matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            );
+            if json && !shows {
+                let text = e.render().to_string();
+                let first = text
+                    .lines()
+                    .next()
+                    .unwrap_or("")
+                    .trim_start_matches("error: ");
+                json_error(reliability::EXIT_USAGE, first);
+                eprintln!("error: {first}");
+                return ExitCode::from(reliability::EXIT_USAGE);
+            }
+            e.exit()
+        }
+    };
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli)));
     let result = match outcome {
         Ok(r) => r,
-        Err(_) => return ExitCode::from(reliability::EXIT_OTHER),
+        Err(_) => {
+            if json {
+                json_error(reliability::EXIT_OTHER, "internal error (please report)");
+            }
+            return ExitCode::from(reliability::EXIT_OTHER);
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -405,11 +438,28 @@ fn main() -> ExitCode {
                     msg.push_str(&c);
                 }
             }
-            eprintln!(
-                "error: {}",
-                reliability::clean_paths(&msg.replace('\n', " "))
-            );
-            ExitCode::from(reliability::exit_code(&e))
+            let msg = reliability::clean_paths(&msg.replace('\n', " "));
+            let code = reliability::exit_code(&e);
+            if json {
+                json_error(code, &msg);
+            }
+            eprintln!("error: {msg}");
+            ExitCode::from(code)
         }
     }
+}
+
+/// Prints `{"error": {"exit_code": code, "kind": …, "message": message}}` on stdout (`--json`);
+/// `kind` is `input`, `usage`, `guarantee` or `other` after the exit code.
+fn json_error(code: u8, message: &str) {
+    let kind = match code {
+        reliability::EXIT_INPUT => "input",
+        reliability::EXIT_USAGE => "usage",
+        reliability::EXIT_NOT_MET => "guarantee",
+        _ => "other",
+    };
+    println!(
+        "{}",
+        serde_json::json!({"error": {"exit_code": code, "kind": kind, "message": message}})
+    );
 }

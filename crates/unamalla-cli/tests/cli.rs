@@ -2,7 +2,7 @@
 //! one clear error line, a non-zero exit code and no output file.
 
 mod common;
-use common::{bin, fixture, tmpdir, RunOk};
+use common::{bin, fixture, report, tmpdir, RunOk};
 
 use std::path::Path;
 
@@ -354,5 +354,107 @@ fn decompose_writes_the_meshers_decomposition() {
             && err.contains("nor the region as read"),
         "{err}"
     );
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `--json`: an error is one JSON object on stdout (besides the line on stderr) whose exit code
+/// and kind match the process's: a missing file is an input error (1), a bad value a usage
+/// error (2, from clap's own parser too).
+#[test]
+fn errors_are_json_with_json() {
+    let dir = tmpdir("json-errors");
+    let cases: [(&[&str], u8, &str); 3] = [
+        (&["mesh", "/nonexistent/region.geojson"], 1, "input"),
+        (&["mesh", "kiwi", "--cells", "abc"], 2, "usage"),
+        (&["mesh", "kiwi", "--shape-target", "1.5"], 2, "usage"),
+    ];
+    for (args, code, kind) in cases {
+        let mut cmd = bin();
+        for a in args {
+            if *a == "kiwi" {
+                cmd.arg(fixture("kiwi-bird.geojson"));
+            } else {
+                cmd.arg(a);
+            }
+        }
+        let out = cmd
+            .arg("-o")
+            .arg(dir.join("out"))
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(code as i32), "{args:?}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{args:?}: stdout is not JSON ({e}): {:?}", out.stdout));
+        assert_eq!(v["error"]["exit_code"], code, "{v}");
+        assert_eq!(v["error"]["kind"], kind, "{v}");
+        assert!(v["error"]["message"]
+            .as_str()
+            .is_some_and(|m| !m.is_empty()));
+        // the stderr line stays
+        assert!(String::from_utf8_lossy(&out.stderr).starts_with("error: "));
+        assert!(!dir.join("out").exists());
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `--strict`: a mesh that misses a target is written and the run exits 3 naming the target.
+/// A comb of ten 1 × 3 teeth on a 21 × 1 bar (every feature kept) needs at least one block per
+/// tooth and bar segment, each with at least one cell, so `--cells 5` misses the count target
+/// by construction; without `--strict` the same run succeeds (it also checks that a mesh with
+/// no interior node — one cell per block — is written, not refused as "nothing to smooth").
+#[test]
+fn strict_exits_3_on_a_missed_target_after_writing() {
+    let dir = tmpdir("strict");
+    let mut ring = vec![[0.0, 0.0], [21.0, 0.0], [21.0, 1.0]];
+    for k in (0..10).rev() {
+        let x0 = 2.0 * k as f64 + 1.0;
+        ring.extend([[x0 + 1.0, 1.0], [x0 + 1.0, 4.0], [x0, 4.0], [x0, 1.0]]);
+    }
+    ring.extend([[0.0, 1.0], [0.0, 0.0]]);
+    let comb = dir.join("comb.geojson");
+    std::fs::write(
+        &comb,
+        serde_json::json!({"type": "Polygon", "coordinates": [ring]}).to_string(),
+    )
+    .unwrap();
+    let run = |strict: bool, out: &Path| {
+        let mut c = bin();
+        c.arg("mesh").arg(&comb).args([
+            "--cells",
+            "5",
+            "--no-simplify",
+            "--feature-factor",
+            "0",
+            "--neck-factor",
+            "0",
+            "--quiet",
+            "--export",
+            "none",
+            "--no-report",
+            "-o",
+        ]);
+        c.arg(out);
+        if strict {
+            c.arg("--strict");
+        }
+        c.output().unwrap()
+    };
+    let plain = run(false, &dir.join("plain"));
+    assert!(
+        plain.status.success(),
+        "{}",
+        String::from_utf8_lossy(&plain.stderr)
+    );
+    let rep = report(&dir.join("plain"));
+    assert!(rep["cells"].as_u64().unwrap() >= 20, "{}", rep["cells"]);
+    let strict = run(true, &dir.join("strict"));
+    assert_eq!(strict.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&strict.stderr);
+    assert!(
+        err.contains("--strict") && err.contains("off the requested 5"),
+        "{err}"
+    );
+    assert!(dir.join("strict").join("mesh.vtu").exists());
     std::fs::remove_dir_all(dir).ok();
 }

@@ -69,7 +69,7 @@ use unamalla_decompose::{
     Layout,
 };
 use unamalla_mesh::quality::QualityReport;
-use unamalla_mesh::{BlockMesh2, DVec2, HasNodes, HasQuadCells, Region};
+use unamalla_mesh::{BlockMesh2, DVec2, FreeNodes, HasNodes, HasQuadCells, Region};
 use unamalla_optim::monitor::{NullObserver, Observer};
 use unamalla_optim::{
     improve_shape, smooth, BoundarySlide, ShapeOptions, ShapeReport, SmoothOptions,
@@ -749,81 +749,90 @@ impl Mesher {
             crate::flat_corners::bend_flat_corners(&mut mesh, self.flat_corner_deficit);
 
         // 7. smooth (region boundary fixed, cut nodes free)
-        self.stage(Stage::Smooth, "smoothing (convexity-preserving)");
-        let mut sopts = self.smooth_opts.clone();
-        if let unamalla_optim::SmoothFunctional::BlockSmoothing { density, .. } =
-            &mut sopts.functional
-        {
-            *density = self.boundary_density;
-        }
-        // the explicit time limit (if any) counts from the start of the stage
-        let t_stage = Instant::now();
-        sopts.time_limit = self.time_limit;
-        // 7-. a start prolonged from smoothed coarse levels ([`crate::multilevel`]); when it is
-        // used, the untangling below has nothing to do (the start is convex)
-        let coarse = match (&counts, submapping.is_none()) {
-            (Some(c), true) => crate::multilevel::coarse_start(
-                &decomposition,
-                self.size,
-                &mesh,
-                &c.counts,
-                &sopts,
-                crate::multilevel::CoarseLevels {
-                    levels: self.coarse_levels,
-                    flat_corner_deficit: self.flat_corner_deficit,
-                },
-                observer,
-            )?,
-            _ => None,
-        };
-        if let Some(c) = &coarse {
-            self.stage(Stage::Smooth, &c.summary());
-            if c.accepted {
-                mesh.global_mut().nodes_mut().copy_from_slice(&c.nodes);
-                sopts = crate::multilevel::polish_options(&sopts);
+        // (a mesh without interior nodes — every node on the region boundary, e.g. one cell
+        // per block — has nothing to smooth: it is kept as the transfinite interpolation made it)
+        let smoothing_status = if mesh.global().num_free() == 0 {
+            self.stage(Stage::Smooth, "no interior node: nothing to smooth");
+            lap(Stage::Smooth, &mut timer);
+            "not smoothed: the mesh has no interior node".to_string()
+        } else {
+            self.stage(Stage::Smooth, "smoothing (convexity-preserving)");
+            let mut sopts = self.smooth_opts.clone();
+            if let unamalla_optim::SmoothFunctional::BlockSmoothing { density, .. } =
+                &mut sopts.functional
+            {
+                *density = self.boundary_density;
             }
-        }
-        // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
-        // block boundaries ([`crate::untangle`]): small problems converge in far fewer
-        // iterations than the global one, the work is bounded by iteration limits (not
-        // wall-clock time, so the result does not depend on the load), and the global run
-        // below then starts convex (or nearly so)
-        let patches = crate::untangle::untangle_patches_observed(
-            mesh.global_mut(),
-            &sopts,
-            &crate::untangle::DEFAULT_PATCH_RADII,
-            observer,
-        )?;
-        if patches.before > 0 {
-            mesh.sync_blocks();
-            let msg = format!(
-                "untangled {} → {} non-convex cells in {} local patch(es) (radius ≤ {}, {} iterations, {:.2} s)",
-                patches.before,
-                patches.after,
-                patches.patches,
-                patches.max_radius,
-                patches.iterations,
-                t_stage.elapsed().as_secs_f64()
-            );
-            self.stage(Stage::Smooth, &msg);
-            if !patches.unresolved.is_empty() {
+            // the explicit time limit (if any) counts from the start of the stage
+            let t_stage = Instant::now();
+            sopts.time_limit = self.time_limit;
+            // 7-. a start prolonged from smoothed coarse levels ([`crate::multilevel`]); when it is
+            // used, the untangling below has nothing to do (the start is convex)
+            let coarse = match (&counts, submapping.is_none()) {
+                (Some(c), true) => crate::multilevel::coarse_start(
+                    &decomposition,
+                    self.size,
+                    &mesh,
+                    &c.counts,
+                    &sopts,
+                    crate::multilevel::CoarseLevels {
+                        levels: self.coarse_levels,
+                        flat_corner_deficit: self.flat_corner_deficit,
+                    },
+                    observer,
+                )?,
+                _ => None,
+            };
+            if let Some(c) = &coarse {
+                self.stage(Stage::Smooth, &c.summary());
+                if c.accepted {
+                    mesh.global_mut().nodes_mut().copy_from_slice(&c.nodes);
+                    sopts = crate::multilevel::polish_options(&sopts);
+                }
+            }
+            // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
+            // block boundaries ([`crate::untangle`]): small problems converge in far fewer
+            // iterations than the global one, the work is bounded by iteration limits (not
+            // wall-clock time, so the result does not depend on the load), and the global run
+            // below then starts convex (or nearly so)
+            let patches = crate::untangle::untangle_patches_observed(
+                mesh.global_mut(),
+                &sopts,
+                &crate::untangle::DEFAULT_PATCH_RADII,
+                observer,
+            )?;
+            if patches.before > 0 {
+                mesh.sync_blocks();
                 let msg = format!(
-                    "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
-                    patches.unresolved.len(),
-                    if patches.cancelled { " (cancelled)" } else { "" },
-                    &patches.unresolved[..patches.unresolved.len().min(8)],
-                    if patches.unresolved.len() > 8 { ", …" } else { "" },
+                    "untangled {} → {} non-convex cells in {} local patch(es) (radius ≤ {}, {} iterations, {:.2} s)",
+                    patches.before,
+                    patches.after,
+                    patches.patches,
+                    patches.max_radius,
+                    patches.iterations,
+                    t_stage.elapsed().as_secs_f64()
                 );
                 self.stage(Stage::Smooth, &msg);
+                if !patches.unresolved.is_empty() {
+                    let msg = format!(
+                        "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
+                        patches.unresolved.len(),
+                        if patches.cancelled { " (cancelled)" } else { "" },
+                        &patches.unresolved[..patches.unresolved.len().min(8)],
+                        if patches.unresolved.len() > 8 { ", …" } else { "" },
+                    );
+                    self.stage(Stage::Smooth, &msg);
+                }
             }
-        }
-        // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
-        if let Some(t) = self.time_limit {
-            sopts.time_limit = Some((t - t_stage.elapsed().as_secs_f64()).max(0.0));
-        }
-        let smoothing = smooth(&mut mesh, &sopts, observer)?;
-        mesh.sync_blocks();
-        lap(Stage::Smooth, &mut timer);
+            // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
+            if let Some(t) = self.time_limit {
+                sopts.time_limit = Some((t - t_stage.elapsed().as_secs_f64()).max(0.0));
+            }
+            let smoothing = smooth(&mut mesh, &sopts, observer)?;
+            mesh.sync_blocks();
+            lap(Stage::Smooth, &mut timer);
+            smoothing.status.to_string()
+        };
 
         // 7c. local shape improvement, the region-boundary nodes sliding along the boundary
         // ([`unamalla_optim::shape`]): the smoother keeps them where the transfinite
@@ -881,7 +890,7 @@ impl Mesher {
             area_change_percent,
             hausdorff,
             holes_dropped,
-            smoothing: smoothing.status.to_string(),
+            smoothing: smoothing_status,
             shape,
             seconds: t0.elapsed().as_secs_f64(),
             stage_seconds,
