@@ -177,6 +177,12 @@ pub struct MeshArgs {
     /// off the request.
     #[arg(long)]
     pub strict: bool,
+    /// Also write rectilinear.json: the rectilinear region R whose piecewise-bilinear image is
+    /// the mesh (one lattice rectangle per block, the lattice position of every node, R's
+    /// boundary rings), or the reason there is none (the development does not close around a
+    /// hole, or overlaps itself).
+    #[arg(long)]
+    pub rectilinear: bool,
     /// For a MultiPolygon: `all` (the default: every part is meshed, into `part-K/`
     /// subdirectories with a summary `report.json`) or one part's 0-based index.
     #[arg(long, value_parser = crate::reliability::parse_part)]
@@ -457,6 +463,16 @@ fn mesh_part(
             &render::quality_png(mesh.global(), Some(&result.simplified), 1600)?,
         )?;
         write_text(&dir.join("report.json"), &json)?;
+        if a.rectilinear {
+            let value = match unamalla_core::mesh::rectilinear::develop(mesh) {
+                Ok(r) => serde_json::to_value(&r)?,
+                Err(e) => serde_json::json!({ "error": e.to_string() }),
+            };
+            write_text(
+                &dir.join("rectilinear.json"),
+                &serde_json::to_string(&value)?,
+            )?;
+        }
         if !a.gis.no_report {
             let settings = crate::report::Settings::of_run(a, loaded, &groups);
             let html = crate::report::report_html(&result, &report, &settings);

@@ -22,6 +22,7 @@ pub mod geometry;
 pub mod grid;
 pub mod hexgen;
 pub mod quality;
+pub mod rectilinear;
 pub mod refine;
 pub mod region;
 pub mod resample;
