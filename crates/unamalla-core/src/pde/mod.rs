@@ -51,6 +51,10 @@
 //! exact for cubic polynomials on affine grids, and it is second-order accurate on grids that
 //! are images of a smooth map (tests and `docs/results.md`).
 //!
+//! (The module [`euler`] holds the other application of the sources: a first-order
+//! finite-volume solver of the 3D Euler equations on hexahedral grids, Cortés Aguirre 2012,
+//! chapter 5.)
+//!
 //! # Meshes
 //!
 //! * [`solve_grid`]: a [`StructuredGrid2`]; the boundary nodes carry the Dirichlet data of
@@ -116,6 +120,7 @@
 //! ```
 
 mod direct;
+pub mod euler;
 pub mod manufactured;
 mod sor;
 mod stencil;
