@@ -39,10 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let grid = ellipsoid_grid((n, n, n), axes, DVec3::ZERO)?;
     let solver = EulerSolver::new(&grid)?;
-    let opts = EulerOptions {
-        end_time,
-        ..EulerOptions::default()
-    };
+    let opts = EulerOptions::until(end_time);
     let centre = DVec3::new(0.0, 0.0, -0.4);
     let mut q = solver.initial_state(opts.gamma, |c| {
         let p = if c.distance(centre) < radius {

@@ -102,15 +102,7 @@ fn sod_error(n: usize) -> f64 {
         let (rho, _, p) = if c.x < 0.5 { l } else { r };
         (rho, DVec3::ZERO, p)
     });
-    let rep = s
-        .run(
-            &mut q,
-            &EulerOptions {
-                end_time: 0.2,
-                ..EulerOptions::default()
-            },
-        )
-        .unwrap();
+    let rep = s.run(&mut q, &EulerOptions::until(0.2)).unwrap();
     assert!((rep.time - 0.2).abs() < 1e-12);
     q.iter()
         .zip(s.centroids())
@@ -161,15 +153,7 @@ fn the_blast_in_a_ball_conserves_and_stays_symmetric() {
         let p = if c.distance(centre) < 0.2 { 5.0 } else { 1.0 };
         (1.0, DVec3::ZERO, p)
     });
-    let rep = s
-        .run(
-            &mut q,
-            &EulerOptions {
-                end_time: 0.2,
-                ..EulerOptions::default()
-            },
-        )
-        .unwrap();
+    let rep = s.run(&mut q, &EulerOptions::until(0.2)).unwrap();
     let rel = |a: [f64; 2]| ((a[1] - a[0]) / a[0]).abs();
     assert!(rel(rep.mass) < 1e-12 && rel(rep.energy) < 1e-12, "{rep:?}");
     assert!(rep.max_p < 5.0 && rep.min_rho_p[0] > 0.0 && rep.min_rho_p[1] > 0.0);

@@ -96,6 +96,16 @@ impl Default for EulerOptions {
     }
 }
 
+impl EulerOptions {
+    /// The default options with the end time `t`.
+    pub fn until(t: f64) -> Self {
+        Self {
+            end_time: t,
+            ..Self::default()
+        }
+    }
+}
+
 /// What a run did.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct EulerReport {
@@ -434,15 +444,7 @@ mod tests {
         let g = ellipsoid_grid((9, 9, 9), DVec3::ONE, DVec3::ZERO).unwrap();
         let s = EulerSolver::new(&g).unwrap();
         let mut q = s.initial_state(1.4, |_| (1.0, DVec3::ZERO, 1.0));
-        let r = s
-            .run(
-                &mut q,
-                &EulerOptions {
-                    end_time: 0.2,
-                    ..EulerOptions::default()
-                },
-            )
-            .unwrap();
+        let r = s.run(&mut q, &EulerOptions::until(0.2)).unwrap();
         assert!(r.steps > 5);
         for st in &q {
             let (rho, u, p) = primitive(1.4, st);
