@@ -172,6 +172,12 @@ pub struct MeshArgs {
     /// (the shape pass moves interior nodes only).
     #[arg(long)]
     pub no_slide: bool,
+    /// When the automatically chosen layout gives μ ≥ 0.8 on fewer than this share of the
+    /// cells (percent), re-make the mesh from the next candidate layouts (at most two more
+    /// runs) and keep the best; 0 turns the retry off. Each try is named in report.json's
+    /// notes.
+    #[arg(long, default_value_t = unamalla_core::pipeline::QUALITY_TARGET_PERCENT)]
+    pub quality_target: f64,
     /// Exit with code 3 (after writing everything) when the mesh misses a quality target:
     /// μ ≥ 0.8 on fewer than 90 % of the cells, or (with --cells) a cell count more than 15 %
     /// off the request.
@@ -357,6 +363,10 @@ fn mesh_part(
         _ => Strategy::Cuts,
     });
     mesher = mesher.allow_non_convex(a.allow_non_convex);
+    if !(a.quality_target.is_finite() && (0.0..=100.0).contains(&a.quality_target)) {
+        bail!("--quality-target must be a percentage between 0 and 100");
+    }
+    mesher = mesher.quality_target(a.quality_target);
     let mut sopts = SimplifyOptions::default();
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);

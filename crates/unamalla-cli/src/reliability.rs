@@ -263,8 +263,9 @@ pub fn finish(not_met: Option<String>) -> Result<()> {
     }
 }
 
-/// `mesh --strict`: the share of cells with μ ≥ 0.8 (percent) a mesh must reach.
-pub const STRICT_GOOD_PERCENT: f64 = 90.0;
+/// `mesh --strict`: the share of cells with μ ≥ 0.8 (percent) a mesh must reach — the
+/// pipeline's default quality target.
+pub const STRICT_GOOD_PERCENT: f64 = unamalla_core::pipeline::QUALITY_TARGET_PERCENT;
 
 /// The quality targets `mesh --strict` checks that `report` misses (empty: all met): μ ≥ 0.8
 /// on at least [`STRICT_GOOD_PERCENT`] % of the cells, and, when a cell count was requested,

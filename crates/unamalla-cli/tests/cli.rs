@@ -136,6 +136,19 @@ fn bad_regions_fail_cleanly_without_output() {
         &["quality", dir.join("missing.vtk").to_str().unwrap()],
         &out,
     );
+    // a quality target that is not a percentage
+    for bad in ["150", "-1", "NaN"] {
+        assert_clean_failure(
+            &[
+                "mesh",
+                fixture("horse.geojson").to_str().unwrap(),
+                &format!("--quality-target={bad}"),
+                "-o",
+                o,
+            ],
+            &out,
+        );
+    }
     std::fs::remove_dir_all(dir).ok();
 }
 

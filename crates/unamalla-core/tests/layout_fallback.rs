@@ -10,7 +10,7 @@ use std::path::Path;
 
 use unamalla_core::io::{self, PartSelector};
 use unamalla_core::mesh::quality::non_convex_cells;
-use unamalla_core::pipeline::{choose_layout_excluding, Mesher, LAYOUT_ASPECTS};
+use unamalla_core::pipeline::{choose_layout_excluding, Mesher, LAYOUT_ASPECTS, QUALITY_FALLBACKS};
 use unamalla_core::verify::{verify_quads, VerifyOptions};
 
 fn region(name: &str) -> unamalla_core::mesh::Region {
@@ -45,7 +45,7 @@ fn a_layout_that_leaves_folds_is_replaced_by_the_next_candidate() {
         .report
         .notes
         .iter()
-        .filter(|n| n.contains("re-made from the next candidate layout"))
+        .filter(|n| n.contains("non-convex or outside the region"))
         .collect();
     for n in &failed {
         assert!(!n.starts_with(&format!("layout {layout} ")), "{n}");
@@ -71,4 +71,75 @@ fn excluded_layouts_are_not_chosen() {
         .chain(LAYOUT_ASPECTS.iter().map(|(n, _)| n.to_string()))
         .collect();
     assert!(choose_layout_excluding(&reg, &opts, size, &all).is_err());
+}
+
+/// The share `X` of a note "layout L reached μ ≥ 0.8 on X % …".
+fn share_in(note: &str) -> Option<f64> {
+    let rest = note.split("reached μ ≥ 0.8 on ").nth(1)?;
+    rest.split(' ').next()?.parse().ok()
+}
+
+/// The quality fallback of `Mesher::mesh_observed`: with the target off (0 %) the chosen
+/// layout is kept; with an unreachable target (100 %) the chosen layout is named as below it
+/// with the share the first run reached, at most `QUALITY_FALLBACKS` other candidates are
+/// made, and the mesh kept is the attempt with the highest share.
+#[test]
+fn a_layout_below_the_quality_target_is_retried_and_the_best_share_kept() {
+    let reg = region("crete");
+    let base = Mesher::new()
+        .cells(2_000)
+        .quality_target(0.0)
+        .mesh(&reg)
+        .expect("crete at 2,000 cells");
+    assert!(
+        !base
+            .report
+            .notes
+            .iter()
+            .any(|n| n.contains("below the target")),
+        "{:?}",
+        base.report.notes
+    );
+    let first = base
+        .report
+        .layout
+        .as_ref()
+        .expect("automatic")
+        .layout
+        .clone();
+    let r = Mesher::new()
+        .cells(2_000)
+        .quality_target(100.0)
+        .mesh(&reg)
+        .expect("crete at 2,000 cells, target 100 %");
+    let below: Vec<&String> = r
+        .report
+        .notes
+        .iter()
+        .filter(|n| n.contains("below the target 100 %"))
+        .collect();
+    assert!(
+        !below.is_empty() && below.len() <= QUALITY_FALLBACKS,
+        "{:?}",
+        r.report.notes
+    );
+    // the first attempt is the run without the target, to the bit
+    assert!(
+        below[0].starts_with(&format!(
+            "layout {first} reached μ ≥ 0.8 on {:.1} % of the cells",
+            base.report.mu_ge_0_8_percent
+        )),
+        "{}",
+        below[0]
+    );
+    let shares: Vec<f64> = r.report.notes.iter().filter_map(|n| share_in(n)).collect();
+    assert_eq!(shares.len(), 2 * below.len(), "{:?}", r.report.notes);
+    let best = shares.iter().copied().fold(0.0, f64::max);
+    let kept = r.report.mu_ge_0_8_percent;
+    assert!(kept >= base.report.mu_ge_0_8_percent);
+    // the notes round to 0.1
+    assert!(
+        (kept - best).abs() <= 0.05 + 1e-9,
+        "kept {kept}, notes {shares:?}"
+    );
 }
