@@ -356,3 +356,125 @@ fn every_shape_at_many_sizes() {
     );
     assert!(failures.len() <= 4, "{failures:#?}");
 }
+
+/// White's method (the paper's baseline, `submap::white`) on a 10 × 10 plate with the hole
+/// [2, 4] × [3, 5], h = 1, derived by hand: the outer square alone is one 10 × 10 piece (100
+/// cells); the hole's vertices nearest the outer contour are (2, 3) and (2, 5), 2 from the left
+/// side (the others are 3 and 4 away); the step-1 mesh has a node exactly there; the shortest
+/// computational ray from it runs 2 steps along −i to (0, y); the return segment (0, y) → (2, y)
+/// is axis-aligned (every junction angle a multiple of 90°), and the merged loop is meshed with
+/// one cell per unit square: 100 − 4 = 96 cells, the same count as the paper's CDT method.
+#[test]
+fn whites_method_on_a_plate_with_one_hole() {
+    use unamalla_decompose::submap::white_submap;
+    let region = Region::new(
+        ring(&[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)]),
+        vec![ring(&[(2.0, 3.0), (4.0, 3.0), (4.0, 5.0), (2.0, 5.0)])],
+    )
+    .unwrap();
+    let opts = SubmapOptions::new(1.0);
+    let w = white_submap(&region, &opts).unwrap();
+    assert_eq!(w.outer_cells, 100);
+    assert_eq!(w.steps.len(), 1);
+    let st = &w.steps[0];
+    assert_eq!(st.hole, 0);
+    assert_eq!(st.initial_vertex.x, 2.0);
+    assert!(
+        st.initial_vertex.y == 3.0 || st.initial_vertex.y == 5.0,
+        "{st:?}"
+    );
+    assert!(st.initial_node.distance(st.initial_vertex) < 1e-9, "{st:?}");
+    assert_eq!(st.cut_length, 2);
+    assert!(st.final_node.distance(DVec2::new(0.0, st.initial_vertex.y)) < 1e-9);
+    let ve = &w.submapping.virtual_edges;
+    assert_eq!(ve.len(), 1);
+    assert!(ve[0].max_deviation_deg < 1e-6, "{ve:?}");
+    assert_eq!(w.submapping.num_cells(), 96);
+    check(&region, &w.submapping);
+    assert_eq!(submap(&region, &opts).unwrap().num_cells(), 96);
+}
+
+/// The drawback the paper's CDT method removes, on a plate [0, 10]² with a long hole
+/// A = [1, 9] × [2, 3] near the bottom and a small hole B = [4.5, 5.5] × [4, 5] above it, h =
+/// 0.5. By hand: A is nearer the outer contour (1) than B (4), so A is joined first (from a
+/// vertex 1 from a side, 2 steps along ±i). B's nearest vertices are (4.5, 4) and (5.5, 4), 4
+/// above the bottom side; the shortest computational ray from that node of the step-1 mesh —
+/// which ignores the holes — is the 8 steps down to the bottom side (left 9, right 9 or 11, up
+/// 12), and the return segment (x, 4) → (x, 0) crosses A: White's method fails on B, while the
+/// CDT method, whose candidate edges all lie inside the region, meshes the plate.
+#[test]
+fn whites_method_fails_where_a_return_segment_crosses_another_hole() {
+    use unamalla_decompose::submap::white_submap;
+    let region = Region::new(
+        ring(&[(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)]),
+        vec![
+            ring(&[(1.0, 2.0), (9.0, 2.0), (9.0, 3.0), (1.0, 3.0)]),
+            ring(&[(4.5, 4.0), (5.5, 4.0), (5.5, 5.0), (4.5, 5.0)]),
+        ],
+    )
+    .unwrap();
+    let opts = SubmapOptions::new(0.5);
+    let e = white_submap(&region, &opts).unwrap_err();
+    assert!(
+        matches!(e, SubmapError::WhiteReturnSegment { hole: 1 }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("hole 1"), "{e}");
+    let s = submap(&region, &opts).unwrap();
+    check(&region, &s);
+    assert_eq!(s.virtual_edges.len(), 2);
+}
+
+/// White's method beside the CDT method on every synthetic shape with holes: where White's
+/// method succeeds its mesh passes the same checks, and it never succeeds where the CDT method
+/// fails (it only adds a requirement); the outcomes are printed for docs/results.md
+/// (`cargo test -p unamalla-decompose --test submap whites_method_on_the_shapes -- --nocapture`).
+#[test]
+fn whites_method_on_the_shapes() {
+    use unamalla_decompose::submap::white_submap;
+    for (name, region) in shapes::all().unwrap() {
+        if region.holes().is_empty() {
+            continue;
+        }
+        let area = region.area();
+        for cells in [500.0, 2000.0] {
+            let opts = SubmapOptions::new((area / cells).sqrt());
+            let cdt = submap(&region, &opts);
+            let white = white_submap(&region, &opts);
+            eprintln!(
+                "{name} h={:.3}: CDT {} / White {}",
+                opts.target_size,
+                cdt.as_ref().map_or_else(
+                    |e| format!("error: {e}"),
+                    |s| format!(
+                        "{} cells, return segments at {:?}° max deviation",
+                        s.num_cells(),
+                        s.virtual_edges
+                            .iter()
+                            .map(|v| v.max_deviation_deg.round())
+                            .collect::<Vec<_>>()
+                    )
+                ),
+                white.as_ref().map_or_else(
+                    |e| format!("error: {e}"),
+                    |w| format!(
+                        "{} cells, return segments at {:?}° max deviation",
+                        w.submapping.num_cells(),
+                        w.submapping
+                            .virtual_edges
+                            .iter()
+                            .map(|v| v.max_deviation_deg.round())
+                            .collect::<Vec<_>>()
+                    )
+                )
+            );
+            if let Ok(w) = &white {
+                check_area(&region, &w.submapping, 1e-9);
+                assert!(
+                    cdt.is_ok(),
+                    "{name}: White's method succeeded where the CDT method failed"
+                );
+            }
+        }
+    }
+}

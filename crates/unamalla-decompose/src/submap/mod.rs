@@ -88,11 +88,13 @@ mod cuts;
 mod output;
 pub mod shapes;
 mod virtual_edges;
+pub mod white;
 
 use unamalla_compat_ilp::{CompatError, Direction, VertexKind};
 use unamalla_mesh::{DVec2, MeshError, Region};
 
 pub use classify::{classify_region, max_right_angle_deviation, prefers_submap, turning_angle};
+pub use white::{white_submap, WhiteStep, WhiteSubmapping};
 
 /// How the necessary condition is imposed when the vertex labels are repaired.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -218,6 +220,20 @@ pub enum SubmapError {
     /// TFI or merging failed.
     #[error(transparent)]
     Mesh(#[from] MeshError),
+    /// A region built on the way (the outer contour alone, White's step 1) is not valid.
+    #[error(transparent)]
+    Geometry(#[from] unamalla_mesh::GeometryError),
+    /// White's method does not apply: the outer contour alone is not submappable (its step 1).
+    #[error("White's method: the outer contour alone is not submappable: {0}")]
+    WhiteOuterNotSubmappable(Box<SubmapError>),
+    /// White's method: the return segment of this hole (0-based) from its vertex nearest the
+    /// outer contour to the end of the shortest computational cut leaves the region or meets an
+    /// earlier one.
+    #[error("White's method: hole {hole}: the return segment to the end of the shortest computational cut leaves the region")]
+    WhiteReturnSegment {
+        /// The hole.
+        hole: usize,
+    },
 }
 
 /// One vertex of the input region with its turning angle and labels.

@@ -269,36 +269,16 @@ pub(crate) fn connect(
             let hole = merged.iter().position(|m| !m).unwrap_or(1) - 1;
             return Err(SubmapError::NoVirtualEdge { hole });
         };
-        let mut hole = holes[rb].take().unwrap_or_default();
-        let (Some(la), Some(lb)) = (locate(&current, pa, ra, tol), locate(&hole, pb, rb, tol))
-        else {
-            return Err(SubmapError::NoVirtualEdge { hole: rb - 1 });
-        };
-        let ia = insert(&mut current, pa, la, &mut key);
-        let ib = insert(&mut hole, pb, lb, &mut key);
-        let v = edges.len();
-        let mut a1 = current[ia].clone();
-        a1.tag = EdgeTag::Virtual(v);
-        a1.brk = true;
-        a1.junction = true;
-        let mut a2 = current[ia].clone();
-        a2.brk = true;
-        a2.junction = true;
-        hole.rotate_left(ib);
-        let mut b1 = hole[0].clone();
-        b1.brk = true;
-        b1.junction = true;
-        let mut b2 = b1.clone();
-        b2.tag = EdgeTag::Virtual(v);
-        let mut next = Vec::with_capacity(current.len() + hole.len() + 3);
-        next.extend_from_slice(&current[..ia]);
-        next.push(a1);
-        next.push(b1);
-        next.extend_from_slice(&hole[1..]);
-        next.push(b2);
-        next.push(a2);
-        next.extend_from_slice(&current[ia + 1..]);
-        current = next;
+        let hole = holes[rb].take().unwrap_or_default();
+        splice(
+            &mut current,
+            hole,
+            (pa, ra),
+            (pb, rb),
+            edges.len(),
+            &mut key,
+            tol,
+        )?;
         merged[rb] = true;
         junctions.push(pa);
         junctions.push(pb);
@@ -311,7 +291,59 @@ pub(crate) fn connect(
         });
     }
 
-    // junction labels by the angle rule, then (1) on the merged loop
+    let repaired = label_junctions(&mut current)?;
+    Ok(Merged {
+        points: current,
+        edges,
+        repaired,
+    })
+}
+
+/// Loop surgery for one virtual edge `v` from `pa` (on the current loop, ring `ra`) to `pb` (on
+/// `hole`, ring `rb`): `outer…A → (A→B) → hole from B around to B → (B→A) → A…outer`.
+fn splice(
+    current: &mut Vec<LPoint>,
+    mut hole: Vec<LPoint>,
+    (pa, ra): (DVec2, usize),
+    (pb, rb): (DVec2, usize),
+    v: usize,
+    key: &mut usize,
+    tol: f64,
+) -> Result<(), SubmapError> {
+    let (Some(la), Some(lb)) = (locate(current, pa, ra, tol), locate(&hole, pb, rb, tol)) else {
+        return Err(SubmapError::NoVirtualEdge { hole: rb - 1 });
+    };
+    let ia = insert(current, pa, la, key);
+    let ib = insert(&mut hole, pb, lb, key);
+    let mut a1 = current[ia].clone();
+    a1.tag = EdgeTag::Virtual(v);
+    a1.brk = true;
+    a1.junction = true;
+    let mut a2 = current[ia].clone();
+    a2.brk = true;
+    a2.junction = true;
+    hole.rotate_left(ib);
+    let mut b1 = hole[0].clone();
+    b1.brk = true;
+    b1.junction = true;
+    let mut b2 = b1.clone();
+    b2.tag = EdgeTag::Virtual(v);
+    let mut next = Vec::with_capacity(current.len() + hole.len() + 3);
+    next.extend_from_slice(&current[..ia]);
+    next.push(a1);
+    next.push(b1);
+    next.extend_from_slice(&hole[1..]);
+    next.push(b2);
+    next.push(a2);
+    next.extend_from_slice(&current[ia + 1..]);
+    *current = next;
+    Ok(())
+}
+
+/// Junction labels by the angle rule, then (1) on the merged loop: if `Σ label ≠ 4`, ILP (6)
+/// relabels the junctions with the ring labels pinned (weight 1000; digest §10.7). Returns
+/// whether the ILP ran.
+fn label_junctions(current: &mut [LPoint]) -> Result<bool, SubmapError> {
     let n = current.len();
     let alpha_at = |lp: &[LPoint], k: usize| {
         turning_angle(
@@ -321,37 +353,109 @@ pub(crate) fn connect(
     };
     for k in 0..n {
         if current[k].junction {
-            current[k].label = rule_label(alpha_at(&current, k));
+            current[k].label = rule_label(alpha_at(current, k));
         }
     }
     let sum: i64 = current.iter().map(|p| p.label).sum();
-    let mut repaired = false;
-    if sum != 4 {
-        let abar: Vec<f64> = (0..n)
-            .map(|k| {
-                if current[k].junction {
-                    alpha_at(&current, k)
-                } else {
-                    current[k].label as f64
-                }
-            })
-            .collect();
-        let w: Vec<f64> = current
-            .iter()
-            .map(|p| if p.junction { 1.0 } else { 1000.0 })
-            .collect();
-        let opts = VertexClassOptions {
-            rho: Some(w.clone()),
-            omega: Some(w),
-            ..VertexClassOptions::default()
-        };
-        let c =
-            classify_vertices_to_sum(&abar, 4, &opts).map_err(SubmapError::MergedClassification)?;
-        for (p, &l) in current.iter_mut().zip(&c.labels) {
-            p.label = l as i64;
-        }
-        repaired = true;
+    if sum == 4 {
+        return Ok(false);
     }
+    let abar: Vec<f64> = (0..n)
+        .map(|k| {
+            if current[k].junction {
+                alpha_at(current, k)
+            } else {
+                current[k].label as f64
+            }
+        })
+        .collect();
+    let w: Vec<f64> = current
+        .iter()
+        .map(|p| if p.junction { 1.0 } else { 1000.0 })
+        .collect();
+    let opts = VertexClassOptions {
+        rho: Some(w.clone()),
+        omega: Some(w),
+        ..VertexClassOptions::default()
+    };
+    let c = classify_vertices_to_sum(&abar, 4, &opts).map_err(SubmapError::MergedClassification)?;
+    for (p, &l) in current.iter_mut().zip(&c.labels) {
+        p.label = l as i64;
+    }
+    Ok(true)
+}
+
+/// The merged loop for virtual edges chosen beforehand (White's method, [`super::white`]):
+/// `chosen[k] = (rb, pa, pb)` joins hole ring `rb` at `pb` to the outer ring at `pa`, in that
+/// order; each segment must lie inside the region and no two may share an end.
+pub(crate) fn connect_prescribed(
+    region: &Region,
+    mut rings: Vec<Vec<LPoint>>,
+    chosen: &[(usize, DVec2, DVec2)],
+) -> Result<Merged, SubmapError> {
+    let mut key = rings.iter().map(|r| r.len()).sum::<usize>();
+    let mut current = rings.remove(0);
+    let (lo, hi) = region.bounding_box();
+    let tol = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
+    let index = region.edge_index();
+    let mut holes: Vec<Option<Vec<LPoint>>> = std::iter::once(None)
+        .chain(rings.into_iter().map(Some))
+        .collect();
+    let mut edges: Vec<VirtualEdge> = Vec::new();
+    let mut junctions: Vec<DVec2> = Vec::new();
+    for &(rb, pa, pb) in chosen {
+        let hole_id = rb.wrapping_sub(1);
+        let Some(hole) = holes.get_mut(rb).and_then(Option::take) else {
+            return Err(SubmapError::NoVirtualEdge { hole: hole_id });
+        };
+        if junctions
+            .iter()
+            .any(|q| q.distance(pa) <= tol || q.distance(pb) <= tol)
+            || !region.segment_inside_with(&index, pa, pb)
+        {
+            return Err(SubmapError::NoVirtualEdge { hole: hole_id });
+        }
+        let (Some(la), Some(lb)) = (locate(&current, pa, 0, tol), locate(&hole, pb, rb, tol))
+        else {
+            return Err(SubmapError::NoVirtualEdge { hole: hole_id });
+        };
+        let (ta_in, ta_out) = tangents(&current, la);
+        let (tb_in, tb_out) = tangents(&hole, lb);
+        let ab = pb - pa;
+        let th = [
+            turning_angle(ta_in, ab),
+            turning_angle(ab, tb_out),
+            turning_angle(tb_in, -ab),
+            turning_angle(-ab, ta_out),
+        ];
+        splice(
+            &mut current,
+            hole,
+            (pa, 0),
+            (pb, rb),
+            edges.len(),
+            &mut key,
+            tol,
+        )?;
+        junctions.push(pa);
+        junctions.push(pb);
+        edges.push(VirtualEdge {
+            a: pa,
+            b: pb,
+            hole: hole_id,
+            junction_angles_deg: th.map(f64::to_degrees),
+            max_deviation_deg: th
+                .map(right_deviation)
+                .iter()
+                .copied()
+                .fold(0.0, f64::max)
+                .to_degrees(),
+        });
+    }
+    if let Some(rb) = holes.iter().position(Option::is_some) {
+        return Err(SubmapError::NoVirtualEdge { hole: rb - 1 });
+    }
+    let repaired = label_junctions(&mut current)?;
     Ok(Merged {
         points: current,
         edges,
