@@ -129,7 +129,7 @@ enum Command {
         /// ivanenko (Σ((ε − α)₊)², ε = 0.01ᾱ: untangling only, no smoothing).
         #[arg(long, default_value = "ao-homega")]
         functional: String,
-        /// Solver: tn-tr, tn-ls, lbfgs, pointwise.
+        /// Solver: tn-tr, tn-ls, lbfgs, pointwise, ncg-fr.
         #[arg(long, default_value = "tn-tr")]
         solver: String,
         /// Weight σ in [0, 1]: of H_ω for ao-homega (default 0.1), of the adaptive functional

@@ -15,6 +15,9 @@
 //!   curvature: stop, or preconditioned steepest descent at the first inner iteration) and a
 //!   Moré–Thuente line search ([`linesearch`], a port of MINPACK-2 `dcsrch`).
 //! * **L-BFGS(m)** ([`Solver::Lbfgs`], two-loop recursion, `m` = 3 or 5 in UNAMALLA, any `m`).
+//! * **Nonlinear CG** ([`Solver::NcgFr`], Fletcher & Reeves 1964; the predecessor system's
+//!   third method, González Flores, thesis, Preface): `β = ‖g_{k+1}‖²/‖g_k‖²`, strong-Wolfe
+//!   Moré–Thuente line search with curvature constant ≤ 0.1, restart every `n` iterations.
 //! * **Pointwise Newton** ([`Solver::Pointwise`], García; seed 001 §B.5.2): Gauss–Seidel
 //!   sweeps over the free nodes, each solving the local 2×2 (3×3) Newton system
 //!   ("simultaneous") or one coordinate at a time ("by components"), with an Armijo test on

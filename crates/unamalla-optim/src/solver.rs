@@ -33,11 +33,24 @@ pub enum Solver {
     Lbfgs,
     /// `pointwise`: Gauss–Seidel sweeps of local 2×2 / 3×3 Newton steps (García).
     Pointwise,
+    /// `ncg-fr`: nonlinear conjugate gradients of Fletcher & Reeves (1964), one of the methods
+    /// of UNAMALLA's predecessor (González Flores, thesis, Preface): `d₀ = −g₀`,
+    /// `d_{k+1} = −g_{k+1} + β_k d_k`, `β_k = ‖g_{k+1}‖²/‖g_k‖²`, with a strong-Wolfe line search
+    /// of curvature constant at most 0.1 (below ½, so every `d_k` is a descent direction:
+    /// Al-Baali 1985) and a restart `d = −g` every `n` iterations or when `d` is not a descent
+    /// direction.
+    NcgFr,
 }
 
 impl Solver {
     /// All solvers.
-    pub const ALL: [Solver; 4] = [Solver::TnTr, Solver::TnLs, Solver::Lbfgs, Solver::Pointwise];
+    pub const ALL: [Solver; 5] = [
+        Solver::TnTr,
+        Solver::TnLs,
+        Solver::Lbfgs,
+        Solver::Pointwise,
+        Solver::NcgFr,
+    ];
     /// The command-line name.
     pub fn name(self) -> &'static str {
         match self {
@@ -45,6 +58,7 @@ impl Solver {
             Solver::TnLs => "tn-ls",
             Solver::Lbfgs => "lbfgs",
             Solver::Pointwise => "pointwise",
+            Solver::NcgFr => "ncg-fr",
         }
     }
 }
@@ -64,7 +78,7 @@ impl FromStr for Solver {
             .ok_or_else(|| OptimError::UnknownName {
                 what: "solver",
                 name: s.to_string(),
-                expected: "tn-tr, tn-ls, lbfgs, pointwise",
+                expected: "tn-tr, tn-ls, lbfgs, pointwise, ncg-fr",
             })
     }
 }
@@ -496,6 +510,7 @@ pub fn minimize_with<P: Problem + ?Sized>(
             }
             Solver::Lbfgs => lbfgs(problem, x, &mut g, opts, session, &mut st),
             Solver::Pointwise => pointwise(problem, x, &mut g, opts, session, &mut st, local_guard),
+            Solver::NcgFr => ncg_fr(problem, x, &mut g, opts, session, &mut st),
         }
     };
     // a run without an accepted step never reached the observer: let it see the run (time
@@ -1033,6 +1048,89 @@ fn lbfgs<P: Problem + ?Sized>(
         }
         x.copy_from_slice(&xt);
         g.copy_from_slice(&gt);
+        let gn = norm(g);
+        if let Some(reason) = st.accept(problem, x, r.f, gn, opts, session, truncated) {
+            return reason;
+        }
+    }
+}
+
+/// Curvature constant of the strong-Wolfe line search of [`Solver::NcgFr`] (at most this; the
+/// Fletcher–Reeves directions are descent directions for any constant below ½).
+const NCG_WOLFE_GTOL: f64 = 0.1;
+
+/// Fletcher–Reeves nonlinear CG ([`Solver::NcgFr`]). The first trial step is `1/‖g‖` after a
+/// restart and otherwise `t_{k−1}·(g_{k−1}·d_{k−1})/(g_k·d_k)` (Nocedal & Wright 2006, (3.60)).
+fn ncg_fr<P: Problem + ?Sized>(
+    problem: &P,
+    x: &mut [f64],
+    g: &mut [f64],
+    opts: &SolverOptions,
+    session: &mut Session<'_>,
+    st: &mut State,
+) -> StopReason {
+    let n = x.len();
+    let mut d: Vec<f64> = g.iter().map(|v| -v).collect();
+    let mut xt = vec![0.0; n];
+    let mut gt = vec![0.0; n];
+    // previous accepted step and slope (for the initial trial step), and the iterations since
+    // the last restart
+    let mut prev: Option<(f64, f64)> = None;
+    let mut since_restart = 0usize;
+    loop {
+        let mut gd = dot(g, &d);
+        if since_restart >= n.max(1) || gd.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) {
+            d.iter_mut().zip(g.iter()).for_each(|(d, g)| *d = -g);
+            gd = dot(g, &d);
+            prev = None;
+            since_restart = 0;
+        }
+        let stp0 = match prev {
+            Some((t, slope)) => (t * slope / gd).clamp(f64::MIN_POSITIVE, 1e20),
+            None => 1.0 / st.gnorm,
+        };
+        let guard = session.guard_active(st.cur_min);
+        let xr: &[f64] = x;
+        let smax = if guard {
+            0.95 * session.max_step(problem, xr, &d)
+        } else {
+            f64::INFINITY
+        };
+        let truncated = smax < stp0;
+        let lsp = LineSearchParams {
+            stpmax: opts.line_search.stpmax.min(smax),
+            gtol: opts.line_search.gtol.min(NCG_WOLFE_GTOL),
+            ..opts.line_search
+        };
+        let mut fe = 0;
+        let r = more_thuente(
+            |t| {
+                fe += 1;
+                add_scaled(xr, t, &d, &mut xt);
+                if guard && !session.admissible(problem, &xt) {
+                    return None;
+                }
+                let f = problem.value_grad(&xt, &mut gt);
+                Some((f, dot(&gt, &d)))
+            },
+            st.f,
+            gd,
+            stp0.min(lsp.stpmax),
+            &lsp,
+        );
+        st.fevals += fe;
+        if r.stp == 0.0 {
+            return StopReason::LineSearch(r.warning.unwrap_or(LineSearchFailure::Rounding));
+        }
+        let g_old2 = dot(g, g);
+        x.copy_from_slice(&xt);
+        g.copy_from_slice(&gt);
+        let beta = dot(g, g) / g_old2;
+        d.iter_mut()
+            .zip(g.iter())
+            .for_each(|(d, g)| *d = -g + beta * *d);
+        prev = Some((r.stp, gd));
+        since_restart += 1;
         let gn = norm(g);
         if let Some(reason) = st.accept(problem, x, r.f, gn, opts, session, truncated) {
             return reason;

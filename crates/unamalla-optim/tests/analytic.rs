@@ -1,6 +1,7 @@
 //! Solvers on analytic problems with known minimizers (before any mesh).
 
 use unamalla_functionals::{Csr, LocalModel, Problem};
+use unamalla_optim::linesearch::LineSearchParams;
 use unamalla_optim::monitor::{Control, Monitor, NullObserver, Session};
 use unamalla_optim::solver::{minimize, PointwiseMode, Solver, SolverOptions};
 use unamalla_optim::status::StopReason;
@@ -329,5 +330,46 @@ fn a_run_without_an_accepted_step_still_reaches_the_observer() {
         drop(s);
         assert_eq!(calls, 1, "{:?}", opts.solver);
         assert_eq!(x, xstar);
+    }
+}
+
+/// Fletcher–Reeves CG on a strictly convex quadratic in `n` variables: with exact line
+/// searches it is linear CG, which reaches the minimizer in at most `n` iterations (Hestenes &
+/// Stiefel 1952; Nocedal & Wright 2006, Thm 5.1). The line search is made exact by a curvature
+/// constant of 10⁻¹⁰ (Moré–Thuente's cubic interpolation then lands on the line minimizer), and
+/// the run must end by the gradient test within `n` iterations (here `n` = 6 and 8; the restart
+/// every `n` iterations is never reached). With the default constant 0.1 it takes 12 for n = 6.
+#[test]
+fn fletcher_reeves_ends_within_n_iterations_on_a_quadratic() {
+    for nodes in [3, 4] {
+        let xstar: Vec<f64> = (0..2 * nodes).map(|i| 1.0 + 0.5 * i as f64).collect();
+        let q = Quadratic::new(nodes, &xstar);
+        let opts = SolverOptions {
+            max_iter: 100,
+            gtol: 1e-9,
+            ftol: 0.0,
+            line_search: LineSearchParams {
+                gtol: 1e-10,
+                ..LineSearchParams::default()
+            },
+            ..SolverOptions::new(Solver::NcgFr)
+        };
+        let mut x = vec![0.0; 2 * nodes];
+        let mut obs = NullObserver;
+        let mut s = Session::new(&q, &x, &mut obs);
+        let r = minimize(&q, &mut x, &opts, &mut s).unwrap();
+        assert_eq!(r.reason, StopReason::Gtol, "{r:?}");
+        assert!(
+            r.iterations <= 2 * nodes,
+            "{} iterations for n = {}",
+            r.iterations,
+            2 * nodes
+        );
+        let err = x
+            .iter()
+            .zip(&xstar)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-8, "{err}");
     }
 }

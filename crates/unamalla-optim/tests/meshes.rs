@@ -162,7 +162,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(8))]
     #[test]
     fn random_perturbations_are_untangled_and_convex_starts_stay_convex(
-        amp in 0.05f64..1.2, seed in 0u64..1000, solver in 0usize..4
+        amp in 0.05f64..1.2, seed in 0u64..1000, solver in 0usize..Solver::ALL.len()
     ) {
         let g0 = sinusoidal(12, 12, 0.06, 1.0).unwrap();
         let mut g = perturbed(&g0, amp, seed);
