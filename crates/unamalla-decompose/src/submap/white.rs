@@ -1,17 +1,18 @@
 //! White's method for multiply connected surfaces, the baseline the submapping paper compares
-//! against (Ruiz-Gironés & Sarrate, "Generation of structured meshes in multiply connected
-//! surfaces using submapping", Advances in Engineering Software 41 (2010) 379–387, §5.1, after
-//! White, Mingwu & Benzley, "Automated hexahedral mesh generation by virtual decomposition",
-//! 4th International Meshing Roundtable, 1995).
+//! against (E. Ruiz-Gironés & J. Sarrate, "Discretización de superficies múltiplemente conexas
+//! mediante submapping", LaCàN, Universitat Politècnica de Catalunya — the section on multiply
+//! connected surfaces and its Fig. 9; the method is its reference 1: D. White, "Automatic
+//! quadrilateral and hexahedral meshing of pseudo-cartesian geometries using virtual
+//! subdivision", Dept. of Civil and Environmental Engineering, Brigham Young University, 1996).
 //!
-//! The paper describes it in five steps:
+//! The paper lists five phases (I)–(V) (it announces four):
 //!
 //! 1. submap the region **ignoring the holes** (the outer contour alone);
 //! 2. sort the holes from nearest to farthest from the outer contour (physical distance);
 //! 3. for each hole, the **initial vertex** is its vertex nearest the outer contour, and the
 //!    **initial node** the node of the step-1 mesh nearest that vertex;
 //! 4. from the initial node, the **shortest cut line in computational space** (the axis rays of
-//!    the paper's cut search, §4.2 there) ends at the **final node** on the outer contour; the
+//!    the paper's cut search) ends at the **final node** on the outer contour; the
 //!    virtual edge joins the initial vertex to the final node;
 //! 5. with every hole connected, submap the merged loop as usual.
 //!
