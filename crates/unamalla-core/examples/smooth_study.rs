@@ -8,13 +8,13 @@
 //! ```
 //!
 //! Candidates (`UNAMALLA_STUDY=name,name` selects some):
-//! * `default` — the pipeline's defaults: [`default_smooth_options`] (σ = 0.5 first stage, then
-//!   σ = 0.1 with window FTOL + quality plateau, cap 1000) with
+//! * `default` — the pipeline's defaults: [`default_smooth_options`] ((6.8) at σ =
+//!   `DEFAULT_SIGMA` = 0.5 with window FTOL + quality plateau, cap 1000) with
 //!   `unamalla_core::multilevel::DEFAULT_COARSE_LEVELS` coarse levels;
 //! * `tfi` — the same options smoothed from the transfinite start (no coarse level; the
 //!   default before the coarse levels);
 //! * `c2f1` / `c2f2` / `c2f3` — one, two or three coarse levels (a quarter of the cells each);
-//! * `converged` — σ = 0.1 alone with the same stop rules;
+//! * `converged` — the default functional without the σ continuation, same stop rules;
 //! * `cap1000` — the stop rules off (FTOL 10⁻¹⁰, GTOL 10⁻⁶, cap 1000): what the old
 //!   smoother reached after 1000 iterations without its clock;
 //! * `plateau` — the quality plateau alone (no window FTOL);
