@@ -3,6 +3,7 @@
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
@@ -14,6 +15,7 @@ use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::geom::{angle_penalty, left_angle, perimeter, project_t, ray_segment, ring_angle};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
+use crate::repair::RepairCache;
 
 /// Weights of the cut score S (see the crate documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,12 +181,15 @@ pub fn chord_layout_cuts(
     // up to ARM_ROUNDS times: blocks that still keep an arm (a part ≥ ARM_SCORE chord widths
     // beyond a chord between two boundary points) get that chord as one more layout cut
     let mut d = None;
+    // the layouts below run Algorithm 1 on mostly the same pieces and repair mostly the
+    // same blocks: those results are shared (exact, see LayoutCache)
+    let cache = Arc::new(LayoutCache::default());
     // the arm chord of a block depends only on its ring and which edges are region boundary;
     // most blocks come back unchanged from one round to the next, so each is searched once
     // (the search triangulates the block, the costliest step of the layout)
     let mut searched: HashMap<Vec<u64>, Option<(DVec2, DVec2)>> = HashMap::new();
     for round in 0..=ARM_ROUNDS {
-        let dec = layout_from_cuts(region, opts, &cuts)?;
+        let dec = layout_from_cuts_cached(region, opts, &cuts, Some(&cache))?;
         let extra: Vec<(DVec2, DVec2)> = if round < ARM_ROUNDS {
             let keyed: Vec<(Vec<u64>, Vec<bool>)> = dec
                 .blocks
@@ -265,7 +270,7 @@ pub fn chord_layout_cuts(
             .filter(|(_, &x)| !x)
             .map(|(&c, _)| c)
             .collect();
-        let nd = layout_from_cuts(region, opts, &kept)?;
+        let nd = layout_from_cuts_cached(region, opts, &kept, Some(&cache))?;
         if inadmissible_blocks(&nd, &opts.tolerances).len() >= bad.len() {
             break;
         }
@@ -300,8 +305,62 @@ pub fn layout_from_cuts(
     opts: &DecomposeOptions,
     cuts: &[(DVec2, DVec2)],
 ) -> Result<Decomposition, DecomposeError> {
+    layout_from_cuts_cached(region, opts, cuts, None)
+}
+
+/// Results that the layouts of one region with one option set share (the rebuilds of
+/// [`chord_layout_cuts`] after each round of arm cuts and each withdrawal differ from each
+/// other in a few pieces only). Each entry is keyed by everything its computation reads, so
+/// a hit returns exactly what the computation would; see [`Builder::run_auto_on_leaves`] and
+/// the repair pass (`Builder::cached_attempt`).
+#[derive(Default)]
+pub(crate) struct LayoutCache {
+    /// Repair attempts (module `repair`).
+    pub repair: Mutex<RepairCache>,
+    /// Algorithm 1 on a leaf piece, keyed by [`piece_key`].
+    leaf_runs: Mutex<HashMap<Vec<u64>, Arc<LeafRun>>>,
+}
+
+/// The exact content of a piece (vertex bits, edge tags with their cut ids, per ring).
+fn piece_key(piece: &Piece) -> Vec<u64> {
+    let mut key = Vec::new();
+    for r in piece.rings() {
+        key.push(r.len() as u64);
+        for (p, t) in r.pts.iter().zip(&r.tags) {
+            key.push(p.x.to_bits());
+            key.push(p.y.to_bits());
+            match *t {
+                Tag::Boundary(b) => key.extend([0, b as u64]),
+                Tag::Cut(c) => key.extend([1, c as u64]),
+            }
+        }
+    }
+    key
+}
+
+/// Algorithm 1 ([`Builder::run_auto`]) on one leaf piece, run in a builder of its own: the
+/// nodes it added (node 0 is the leaf, with an empty label), the cuts it made, the pieces.
+/// Cut ids from `base` on are its new cuts (`cuts[c - base]`), lower ones are the cuts the
+/// piece had already.
+struct LeafRun {
+    base: usize,
+    cuts: Vec<(DVec2, DVec2)>,
+    nodes: Vec<TreeNode>,
+    pieces: Vec<Option<Piece>>,
+}
+
+/// [`layout_from_cuts`] with the Algorithm 1 runs and repair attempts of earlier layouts of
+/// the same region and options ([`LayoutCache`]; the cache only saves work: every entry is
+/// what the builder would compute).
+fn layout_from_cuts_cached(
+    region: &Region,
+    opts: &DecomposeOptions,
+    cuts: &[(DVec2, DVec2)],
+    cache: Option<&Arc<LayoutCache>>,
+) -> Result<Decomposition, DecomposeError> {
     let tol = crate::decomposition::boundary_tol(region);
     let mut b = Builder::new(region, opts);
+    b.cache = cache.cloned();
     for &(p, q) in cuts {
         b.apply_cut(p, q, tol, Step::Chord);
     }
@@ -381,6 +440,9 @@ pub(crate) struct Builder<'a> {
     /// Run the corner repair in [`Builder::finish`] (off for a file that lists cuts only: those
     /// are exactly the user's cuts).
     pub auto_repair: bool,
+    /// Work shared with the other builders of one region and option set (the rebuilds of
+    /// [`chord_layout_cuts`]); `None`: nothing is cached.
+    pub(crate) cache: Option<Arc<LayoutCache>>,
 }
 
 impl<'a> Builder<'a> {
@@ -415,6 +477,7 @@ impl<'a> Builder<'a> {
             min_area: opts.min_area_fraction * region.area(),
             min_triangle: opts.min_triangle_fraction * region.area(),
             auto_repair: true,
+            cache: None,
         }
     }
 
@@ -541,14 +604,141 @@ impl<'a> Builder<'a> {
     }
 
     /// Runs Algorithm 1 ([`Builder::run_auto`]) on every current leaf piece.
+    ///
+    /// The leaves are run in parallel, each in a builder of its own ([`LeafRun`]), and the
+    /// runs are appended in leaf order, which is exactly the sequential result: Algorithm 1
+    /// on a leaf reads only its piece, the options and the minimum areas (never another
+    /// leaf, nor the value of a cut id — only whether an edge is a cut), and it appends its
+    /// nodes and cuts in the same order; new cut ids are renumbered from the cut count at
+    /// the leaf's turn and node labels prefixed with the leaf's label. The one global read,
+    /// the block budget (`leaves() >= max_blocks`), is met by a fallback: when the runs would
+    /// reach it, everything is run sequentially instead. A run is cached by its piece
+    /// ([`LayoutCache`]); a failing run also falls back (the sequential error is the first
+    /// leaf's error).
     pub fn run_auto_on_leaves(&mut self) -> Result<(), DecomposeError> {
         let leaves: Vec<usize> = (0..self.nodes.len())
             .filter(|&n| self.pieces[n].is_some())
             .collect();
-        for n in leaves {
-            self.run_auto(n)?;
+        let runs: Vec<Option<Arc<LeafRun>>> =
+            leaves.par_iter().map(|&n| self.leaf_run(n)).collect();
+        // every branch turns one leaf into two
+        let added: usize = runs
+            .iter()
+            .map(|r| r.as_ref().map_or(0, |r| (r.nodes.len() - 1) / 2))
+            .sum();
+        if runs.iter().any(Option::is_none) || self.leaves() + added >= self.opts.max_blocks {
+            for n in leaves {
+                self.run_auto(n)?;
+            }
+            return Ok(());
+        }
+        for (n, run) in leaves.into_iter().zip(runs) {
+            if let Some(run) = run {
+                self.append_leaf_run(n, &run);
+            }
         }
         Ok(())
+    }
+
+    /// Algorithm 1 on leaf `n` in a builder of its own (or from the cache); `None` if it
+    /// fails.
+    fn leaf_run(&self, n: usize) -> Option<Arc<LeafRun>> {
+        let piece = self.pieces[n].as_ref()?;
+        let key = self.cache.as_ref().map(|_| piece_key(piece));
+        if let (Some(cache), Some(key)) = (self.cache.as_ref(), key.as_ref()) {
+            if let Some(run) = cache.leaf_runs.lock().ok()?.get(key) {
+                return Some(run.clone());
+            }
+        }
+        let base = self.cuts.len();
+        let mut b = Builder {
+            region: self.region,
+            opts: self.opts,
+            cuts: self.cuts.clone(),
+            nodes: vec![TreeNode {
+                label: String::new(),
+                parent: None,
+                children: Vec::new(),
+                step: None,
+                cuts: Vec::new(),
+                block: None,
+            }],
+            pieces: vec![Some(piece.clone())],
+            protected_cuts: self.protected_cuts,
+            min_area: self.min_area,
+            min_triangle: self.min_triangle,
+            auto_repair: self.auto_repair,
+            cache: None,
+        };
+        b.run_auto(0).ok()?;
+        let run = Arc::new(LeafRun {
+            base,
+            cuts: b.cuts.split_off(base),
+            nodes: b.nodes,
+            pieces: b.pieces,
+        });
+        if let (Some(cache), Some(key)) = (self.cache.as_ref(), key) {
+            cache.leaf_runs.lock().ok()?.insert(key, run.clone());
+        }
+        Some(run)
+    }
+
+    /// Appends a [`LeafRun`] of leaf `n`: its new cuts get the next ids, its nodes the next
+    /// node ids and the leaf's label as prefix.
+    fn append_leaf_run(&mut self, n: usize, run: &LeafRun) {
+        let cut_base = self.cuts.len();
+        let cut = |c: usize| {
+            if c >= run.base {
+                c - run.base + cut_base
+            } else {
+                c
+            }
+        };
+        let node_base = self.nodes.len() - 1;
+        let node = |i: usize| if i == 0 { n } else { i + node_base };
+        let prefix = self.nodes[n].label.clone();
+        self.cuts.extend_from_slice(&run.cuts);
+        let retag = |p: &Piece| {
+            let mut p = p.clone();
+            for r in std::iter::once(&mut p.outer).chain(p.holes.iter_mut()) {
+                for t in &mut r.tags {
+                    if let Tag::Cut(c) = t {
+                        *c = cut(*c);
+                    }
+                }
+            }
+            p
+        };
+        for (i, (t, p)) in run.nodes.iter().zip(&run.pieces).enumerate() {
+            let children = t.children.iter().map(|&c| node(c)).collect();
+            let cuts = t.cuts.iter().map(|&c| cut(c)).collect();
+            let piece = p.as_ref().map(retag);
+            if i == 0 {
+                // a leaf that Algorithm 1 left whole is untouched (it may carry the cut of a
+                // hole bridge); a split one is overwritten as `branch` does
+                if !t.children.is_empty() {
+                    let root = &mut self.nodes[n];
+                    root.children = children;
+                    root.step = t.step;
+                    root.cuts = cuts;
+                    self.pieces[n] = piece;
+                }
+            } else {
+                self.nodes.push(TreeNode {
+                    label: if prefix.is_empty() {
+                        t.label.clone()
+                    } else {
+                        format!("{prefix}.{}", t.label)
+                    },
+                    parent: t.parent.map(node),
+                    children,
+                    step: t.step,
+                    cuts,
+                    block: t.block,
+                });
+                self.pieces.push(piece);
+            }
+        }
     }
 
     /// Algorithm 1 on the subtree rooted at `root` (a leaf).

@@ -53,6 +53,7 @@
 //!    than a less admissible block. [`Decomposition::cut_joints`](crate::Decomposition::cut_joints)
 //!    lists the joints that remain (none on the fixture regions, tested).
 
+use rayon::prelude::*;
 use unamalla_mesh::DVec2;
 
 use crate::auto::{needs_cut_point, triangle_plan, Builder};
@@ -123,63 +124,6 @@ fn ring_key(r: &Ring) -> DVec2 {
     r.pts.iter().fold(DVec2::ZERO, |acc, p| acc + *p)
 }
 
-/// A fingerprint of block slot `k`, the blocks across its cuts and the blocks across theirs
-/// (rings, tags and the liveness of those cuts): what the three repair steps of
-/// [`Builder::repair_pass`] read. `DefaultHasher::new()` has fixed keys, so the value is the
-/// same in every run.
-fn neighbourhood_fingerprint(slot: &[Option<Ring>], k: usize, alive: &[bool]) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    let across = |r: &Ring| -> Vec<usize> {
-        r.tags
-            .iter()
-            .filter_map(|t| match *t {
-                Tag::Cut(c) => Some(c),
-                _ => None,
-            })
-            .flat_map(|c| {
-                slot.iter().enumerate().filter_map(move |(j, o)| {
-                    o.as_ref()
-                        .filter(|o| o.tags.contains(&Tag::Cut(c)))
-                        .map(|_| j)
-                })
-            })
-            .collect()
-    };
-    let mut seen = vec![k];
-    let mut frontier = vec![k];
-    for _ in 0..2 {
-        let mut next = Vec::new();
-        for &s in &frontier {
-            if let Some(r) = slot[s].as_ref() {
-                for j in across(r) {
-                    if !seen.contains(&j) {
-                        seen.push(j);
-                        next.push(j);
-                    }
-                }
-            }
-        }
-        frontier = next;
-    }
-    for &s in &seen {
-        s.hash(&mut h);
-        if let Some(r) = slot[s].as_ref() {
-            for (p, t) in r.pts.iter().zip(&r.tags) {
-                p.x.to_bits().hash(&mut h);
-                p.y.to_bits().hash(&mut h);
-                match *t {
-                    Tag::Cut(c) => {
-                        (1u8, c, alive.get(c).copied().unwrap_or(false)).hash(&mut h);
-                    }
-                    Tag::Boundary(b) => (0u8, b).hash(&mut h),
-                }
-            }
-        }
-    }
-    h.finish()
-}
-
 /// A split candidate: score, the two children (new cut tagged [`TMP_CUT`]), cut endpoints.
 type Split = (f64, Ring, Ring, (DVec2, DVec2));
 
@@ -198,6 +142,225 @@ const RESPLIT_SLACK: f64 = 0.05;
 
 /// The placeholder tags of the first and second cut of a [`Resplit`].
 const TMP_IDS: [usize; 2] = [TMP_CUT2, TMP_CUT];
+
+/// What one repair attempt of a block found (steps 1–3 of [`Builder::repair_pass`]).
+#[derive(Clone)]
+enum Attempt {
+    /// Step 1: a split of the block alone.
+    Split(Split),
+    /// Step 2: a merge with a neighbour (possibly re-split).
+    Merge(Merge),
+    /// Step 3: a re-split of the block or of a union with neighbours.
+    Resplit(Host, Resplit),
+    /// Nothing found.
+    Fail,
+}
+
+/// Whether cut id `c` is one of the placeholders of a candidate ([`TMP_CUT`], [`TMP_CUT2`]).
+fn placeholder(c: usize) -> bool {
+    c == TMP_CUT || c == TMP_CUT2
+}
+
+/// `r` with every cut id `c` (placeholders excepted) replaced by `cut(c)`; `None` if `cut`
+/// has no image for one of them.
+fn relabel_ring(r: &Ring, cut: &dyn Fn(usize) -> Option<usize>) -> Option<Ring> {
+    let tags = r
+        .tags
+        .iter()
+        .map(|t| match *t {
+            Tag::Cut(c) if !placeholder(c) => cut(c).map(Tag::Cut),
+            t => Some(t),
+        })
+        .collect::<Option<Vec<Tag>>>()?;
+    Some(Ring {
+        pts: r.pts.clone(),
+        tags,
+    })
+}
+
+/// [`relabel_ring`] for both children of a [`Split`].
+fn relabel_split(s: &Split, cut: &dyn Fn(usize) -> Option<usize>) -> Option<Split> {
+    Some((s.0, relabel_ring(&s.1, cut)?, relabel_ring(&s.2, cut)?, s.3))
+}
+
+impl Attempt {
+    /// The attempt with slot numbers mapped by `slot` and cut ids by `cut` (placeholders
+    /// kept); `None` if a map has no image for one of them.
+    fn relabel(
+        &self,
+        slot: &dyn Fn(usize) -> Option<usize>,
+        cut: &dyn Fn(usize) -> Option<usize>,
+    ) -> Option<Attempt> {
+        Some(match self {
+            Attempt::Split(s) => Attempt::Split(relabel_split(s, cut)?),
+            Attempt::Merge((s, j, c, split, u)) => Attempt::Merge((
+                *s,
+                slot(*j)?,
+                cut(*c)?,
+                match split {
+                    Some(x) => Some(relabel_split(x, cut)?),
+                    None => None,
+                },
+                relabel_ring(u, cut)?,
+            )),
+            Attempt::Resplit(host, (s, rings, ends)) => {
+                let host = match *host {
+                    Host::Alone => Host::Alone,
+                    Host::Merged { j, c } => Host::Merged {
+                        j: slot(j)?,
+                        c: cut(c)?,
+                    },
+                    Host::Merged2 { j, c, j2, c2 } => Host::Merged2 {
+                        j: slot(j)?,
+                        c: cut(c)?,
+                        j2: slot(j2)?,
+                        c2: cut(c2)?,
+                    },
+                };
+                let rings = rings
+                    .iter()
+                    .map(|r| relabel_ring(r, cut))
+                    .collect::<Option<Vec<Ring>>>()?;
+                Attempt::Resplit(host, (*s, rings, ends.clone()))
+            }
+            Attempt::Fail => Attempt::Fail,
+        })
+    }
+}
+
+/// Repair attempts of earlier passes over the same region with the same options (the
+/// rebuilds of [`crate::auto::chord_layout_cuts`] repair mostly the same blocks again), keyed
+/// by [`Neighbourhood::key`], with slot numbers and cut ids in the key's canonical numbering.
+#[derive(Default)]
+pub(crate) struct RepairCache {
+    attempts: std::collections::HashMap<Vec<u64>, Attempt>,
+}
+
+/// The neighbourhood of a block that a repair attempt reads: block slot `k`, the blocks
+/// across its cuts and the blocks across theirs (rings, tags, and whether those cuts are
+/// alive and protected), in a numbering independent of slot numbers and cut ids (`key`) and
+/// the numbering itself (`slots`, `cuts`): two neighbourhoods are equal exactly when they
+/// hold the same blocks in the same slots with the same cuts.
+#[derive(PartialEq)]
+struct Neighbourhood {
+    /// The slots, block first, in the order of discovery (canonical slot `i` is `slots[i]`).
+    slots: Vec<usize>,
+    /// The cut ids in order of first appearance in the key (canonical cut `i` is `cuts[i]`).
+    cuts: Vec<usize>,
+    /// For each slot in order: the rank of its slot number among `slots` (the attempt picks
+    /// the first slot holding a cut), its vertices, and per edge the original-boundary ring
+    /// or the canonical cut id with whether the cut is protected and alive.
+    key: Vec<u64>,
+}
+
+impl Neighbourhood {
+    /// The neighbourhood of block slot `k`.
+    fn new(slot: &[Option<Ring>], k: usize, alive: &[bool], protected: usize) -> Self {
+        // the slots holding each cut, in slot order (as `neighbour_unions` searches them)
+        let mut holders: std::collections::HashMap<usize, Vec<usize>> =
+            std::collections::HashMap::new();
+        for (j, o) in slot.iter().enumerate() {
+            for t in o.iter().flat_map(|r| r.tags.iter()) {
+                if let Tag::Cut(c) = *t {
+                    let h = holders.entry(c).or_default();
+                    if h.last() != Some(&j) {
+                        h.push(j);
+                    }
+                }
+            }
+        }
+        let mut slots = vec![k];
+        let mut frontier = vec![k];
+        for _ in 0..2 {
+            let mut next = Vec::new();
+            for &s in &frontier {
+                for t in slot[s].iter().flat_map(|r| r.tags.iter()) {
+                    let Tag::Cut(c) = *t else { continue };
+                    for &j in holders.get(&c).map(Vec::as_slice).unwrap_or(&[]) {
+                        if !slots.contains(&j) {
+                            slots.push(j);
+                            next.push(j);
+                        }
+                    }
+                }
+            }
+            frontier = next;
+        }
+        let mut sorted = slots.clone();
+        sorted.sort_unstable();
+        let mut cuts: Vec<usize> = Vec::new();
+        let mut key = vec![slots.len() as u64];
+        for &s in &slots {
+            key.push(sorted.binary_search(&s).unwrap_or(usize::MAX) as u64);
+            let Some(r) = slot[s].as_ref() else {
+                key.push(u64::MAX);
+                continue;
+            };
+            key.push(r.len() as u64);
+            for (p, t) in r.pts.iter().zip(&r.tags) {
+                key.push(p.x.to_bits());
+                key.push(p.y.to_bits());
+                match *t {
+                    Tag::Boundary(b) => key.extend([0, b as u64]),
+                    Tag::Cut(c) => {
+                        let canon = match cuts.iter().position(|&x| x == c) {
+                            Some(i) => i,
+                            None => {
+                                cuts.push(c);
+                                cuts.len() - 1
+                            }
+                        };
+                        let live = alive.get(c).copied().unwrap_or(false);
+                        key.extend([1, canon as u64, (c < protected) as u64, live as u64]);
+                    }
+                }
+            }
+        }
+        Self { slots, cuts, key }
+    }
+}
+
+/// A memo of [`Builder::good_fit`] by exact vertex sequence, for one re-split search
+/// ([`Builder::best_resplit`]): its two-cut searches meet the same child rings many times
+/// (a block cut by X then Y has the pieces of the block cut by Y then X, and the second-cut
+/// searches of different first cuts share most of their children). Exact: `good_fit` is a
+/// function of the vertex sequence alone (the builder's options and minimum area are fixed),
+/// and entries are matched on the full sequence, bit for bit.
+#[derive(Default)]
+struct FitMemo(std::sync::Mutex<std::collections::HashMap<u64, Vec<FitEntry>>>);
+
+/// An entry of a [`FitMemo`]: a vertex sequence and its `good_fit`.
+type FitEntry = (Box<[DVec2]>, Option<f64>);
+
+impl FitMemo {
+    /// `b.good_fit(ring)`, computed once per vertex sequence.
+    fn good_fit(&self, b: &Builder<'_>, ring: &Ring) -> Option<f64> {
+        use std::hash::{Hash, Hasher};
+        let same = |p: &[DVec2]| {
+            p.len() == ring.pts.len()
+                && p.iter()
+                    .zip(&ring.pts)
+                    .all(|(a, b)| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits())
+        };
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for p in &ring.pts {
+            (p.x.to_bits(), p.y.to_bits()).hash(&mut h);
+        }
+        let h = h.finish();
+        if let Ok(m) = self.0.lock() {
+            if let Some(f) = m.get(&h).and_then(|v| v.iter().find(|e| same(&e.0))) {
+                return f.1;
+            }
+        }
+        let f = b.good_fit(ring);
+        if let Ok(mut m) = self.0.lock() {
+            m.entry(h)
+                .or_default()
+                .push((ring.pts.clone().into_boxed_slice(), f));
+        }
+        f
+    }
+}
 
 /// Where a re-split applies: the block alone, its union with the neighbour in slot
 /// `j` across cut `c`, or its union with two neighbours (`j` across `c`, then `j2` across `c2`,
@@ -284,7 +447,11 @@ impl Builder<'_> {
     /// The quarter points of the original-boundary edges are offered only when the vertices
     /// and feet give no acceptable split (so they add repairs without changing the ones that
     /// worked before), and only with [`DecomposeOptions::edge_point_cuts`](crate::DecomposeOptions::edge_point_cuts).
-    fn best_split_by(&self, ring: &Ring, accept: &dyn Fn(&Ring) -> Option<f64>) -> Option<Split> {
+    fn best_split_by(
+        &self,
+        ring: &Ring,
+        accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
+    ) -> Option<Split> {
         self.best_split_with(ring, accept, false).or_else(|| {
             self.opts
                 .edge_point_cuts
@@ -297,7 +464,7 @@ impl Builder<'_> {
     fn best_split_with(
         &self,
         ring: &Ring,
-        accept: &dyn Fn(&Ring) -> Option<f64>,
+        accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         quarter_points: bool,
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
@@ -406,32 +573,43 @@ impl Builder<'_> {
     /// not already give two accepted children are followed (those are steps 1–2). Score
     /// `½·max(F₁, F₂, F₃) + (F₁ + F₂ + F₃)/6 + pre₁ + pre₂` — the two-child score
     /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
-    fn best_split3(&self, ring: &Ring, accept: &dyn Fn(&Ring) -> Option<f64>) -> Option<Resplit> {
+    fn best_split3(
+        &self,
+        ring: &Ring,
+        accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
+    ) -> Option<Resplit> {
         let mut best: Option<Resplit> = None;
         for quarter_points in [false, true] {
             if quarter_points && (best.is_some() || !self.opts.edge_point_cuts) {
                 break;
             }
+            // the first cuts in their order, then the second-cut searches in parallel, the
+            // results compared in that same order (as a sequential loop would)
+            let mut firsts = Vec::new();
             self.for_each_split(ring, quarter_points, &mut |pre1, a, b, ends1| {
-                let (fa, fb) = (accept(&a), accept(&b));
-                let (kept, fk, rest) = match (fa, fb) {
-                    (Some(fa), None) => (a, fa, b),
-                    (None, Some(fb)) => (b, fb, a),
-                    _ => return,
-                };
-                let Some((s2, r1, r2, ends2)) = self.best_split_by(&as_first_cut(rest), accept)
-                else {
-                    return;
-                };
-                let (Some(f1), Some(f2)) = (accept(&r1), accept(&r2)) else {
-                    return;
-                };
-                let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
-                let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
-                if best.as_ref().is_none_or(|b| s < b.0) {
-                    best = Some((s, vec![as_first_cut(kept), r1, r2], vec![ends1, ends2]));
-                }
+                firsts.push((pre1, a, b, ends1));
             });
+            let found: Vec<Option<Resplit>> = firsts
+                .into_par_iter()
+                .map(|(pre1, a, b, ends1)| {
+                    let (fa, fb) = (accept(&a), accept(&b));
+                    let (kept, fk, rest) = match (fa, fb) {
+                        (Some(fa), None) => (a, fa, b),
+                        (None, Some(fb)) => (b, fb, a),
+                        _ => return None,
+                    };
+                    let (s2, r1, r2, ends2) = self.best_split_by(&as_first_cut(rest), accept)?;
+                    let (f1, f2) = (accept(&r1)?, accept(&r2)?);
+                    let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
+                    let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
+                    Some((s, vec![as_first_cut(kept), r1, r2], vec![ends1, ends2]))
+                })
+                .collect();
+            for c in found.into_iter().flatten() {
+                if best.as_ref().is_none_or(|b| c.0 < b.0) {
+                    best = Some(c);
+                }
+            }
         }
         best
     }
@@ -504,7 +682,7 @@ impl Builder<'_> {
         slot: &[Option<Ring>],
         k: usize,
         alive: &[bool],
-        accept: &dyn Fn(&Ring) -> Option<f64>,
+        accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
     ) -> Option<Merge> {
         let mut best: Option<Merge> = None;
         let r = slot[k].as_ref()?;
@@ -595,6 +773,7 @@ impl Builder<'_> {
             hosts.push((Host::Merged { j, c }, u));
         }
         hosts.append(&mut hosts2);
+        let memo = FitMemo::default();
         // corner scores of the good blocks among the hosts' blocks, each computed once
         let mut fits: Vec<(usize, Option<f64>)> = Vec::new();
         let mut best: Option<(Host, Resplit)> = None;
@@ -625,7 +804,7 @@ impl Builder<'_> {
             if limit == f64::NEG_INFINITY {
                 limit = f64::INFINITY;
             }
-            let good = |u: &Ring| self.good_fit(u).filter(|&f| f <= limit);
+            let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
             let two = matches!(host, Host::Merged2 { .. })
                 .then(|| self.best_split_by(&u, &good))
                 .flatten()
@@ -782,6 +961,63 @@ impl Builder<'_> {
         }
     }
 
+    /// Steps 1–3 of the repair of block slot `k` (ring `r`), in that order: the first step
+    /// that finds something decides.
+    fn attempt(&self, slot: &[Option<Ring>], k: usize, alive: &[bool], r: &Ring) -> Attempt {
+        if let Some(s) = self.best_split(r) {
+            return Attempt::Split(s);
+        }
+        if let Some(m) = self.best_merge(slot, k, alive, &|u: &Ring| self.good_fit(u)) {
+            return Attempt::Merge(m);
+        }
+        match self.best_resplit(slot, k, alive) {
+            Some((host, t)) => Attempt::Resplit(host, t),
+            None => Attempt::Fail,
+        }
+    }
+
+    /// [`Builder::attempt`] through the builder's [`RepairCache`] (if it has one).
+    ///
+    /// Exact: the attempt reads only the rings of the blocks in the neighbourhood of `k`
+    /// (block `k`, the blocks across its cuts and the blocks across theirs), which of their
+    /// cuts are alive and protected, and which slots share a cut (and in which slot order);
+    /// the builder's options and minimum area are the same for every builder sharing a cache
+    /// (one region, one option set). [`Neighbourhood`] encodes exactly that with slot numbers
+    /// replaced by their rank in the neighbourhood and cut ids by their order of appearance,
+    /// so an equal key means the same search on relabelled input, whose result is the cached
+    /// one relabelled back. The key is stored whole (no hash collision can change a result).
+    fn cached_attempt(
+        &self,
+        slot: &[Option<Ring>],
+        k: usize,
+        alive: &[bool],
+        r: &Ring,
+        nb: &Neighbourhood,
+    ) -> Attempt {
+        let Some(cache) = self.cache.as_ref().map(|c| &c.repair) else {
+            return self.attempt(slot, k, alive, r);
+        };
+        let hit = cache
+            .lock()
+            .ok()
+            .and_then(|c| c.attempts.get(&nb.key).cloned());
+        if let Some(a) = hit {
+            if let Some(a) = a.relabel(&|p| nb.slots.get(p).copied(), &|c| nb.cuts.get(c).copied())
+            {
+                return a;
+            }
+        }
+        let a = self.attempt(slot, k, alive, r);
+        if let Some(canon) = a.relabel(&|s| nb.slots.iter().position(|&x| x == s), &|c| {
+            nb.cuts.iter().position(|&x| x == c)
+        }) {
+            if let Ok(mut c) = cache.lock() {
+                c.attempts.insert(nb.key.clone(), canon);
+            }
+        }
+        a
+    }
+
     /// The corner-repair pass (module documentation). `rings[k]` is block `k`; the tree's leaf
     /// nodes point to block ids. Returns the new blocks (cuts and tree renumbered).
     pub(crate) fn repair_pass(&mut self, rings: Vec<Ring>) -> Vec<Ring> {
@@ -793,10 +1029,10 @@ impl Builder<'_> {
         // a repair changes the neighbours of blocks already passed over: sweep again while
         // the last sweep changed something (and the budget lasts)
         let mut changed = false;
-        // the neighbourhood fingerprint of each block whose repair failed: the search depends
-        // only on the block, its neighbours and theirs (and the live cuts between them), so
-        // while those are unchanged a later sweep would fail again on the same candidates
-        let mut failed: Vec<Option<u64>> = Vec::new();
+        // the neighbourhood of each block whose repair failed: the search depends only on the
+        // block, its neighbours and theirs (and the live cuts between them), so while those
+        // are unchanged a later sweep would fail again on the same candidates
+        let mut failed: Vec<Option<Neighbourhood>> = Vec::new();
         while budget > 0 {
             if k >= slot.len() {
                 if !changed {
@@ -812,41 +1048,39 @@ impl Builder<'_> {
                 k += 1;
                 continue;
             }
-            let print = neighbourhood_fingerprint(&slot, k, &alive);
-            if failed.get(k).copied().flatten() == Some(print) {
+            let nb = Neighbourhood::new(&slot, k, &alive, self.protected_cuts);
+            if failed.get(k).is_some_and(|f| f.as_ref() == Some(&nb)) {
                 k += 1;
                 continue;
             }
             budget -= 1;
-            // 1. split alone
-            if let Some((_, a, b, ends)) = self.best_split(&r) {
-                let (a, b, id) = self.commit_split(a, b, ends);
-                alive.push(true);
-                slot[k] = Some(a);
-                slot.push(Some(b));
-                owner.push(slot.len() - 1);
-                self.branch_leaf(k, slot.len() - 1, id);
-                changed = true;
-                continue;
-            }
-            // 2. merge with a neighbour, possibly followed by a split
-            if let Some(m) = self.best_merge(&slot, k, &alive, &|u: &Ring| self.good_fit(u)) {
-                self.apply_merge(&mut slot, &mut owner, &mut alive, k, m);
-                changed = true;
-                continue;
-            }
-            // 3. the block alone or merged with one neighbour, by two cuts into three good
-            //    blocks; merged with two neighbours, by one or two cuts
-            match self.best_resplit(&slot, k, &alive) {
-                Some(t) => {
-                    self.apply_resplit(&mut slot, &mut owner, &mut alive, k, t);
+            match self.cached_attempt(&slot, k, &alive, &r, &nb) {
+                // 1. split alone
+                Attempt::Split((_, a, b, ends)) => {
+                    let (a, b, id) = self.commit_split(a, b, ends);
+                    alive.push(true);
+                    slot[k] = Some(a);
+                    slot.push(Some(b));
+                    owner.push(slot.len() - 1);
+                    self.branch_leaf(k, slot.len() - 1, id);
                     changed = true;
                 }
-                None => {
+                // 2. merge with a neighbour, possibly followed by a split
+                Attempt::Merge(m) => {
+                    self.apply_merge(&mut slot, &mut owner, &mut alive, k, m);
+                    changed = true;
+                }
+                // 3. the block alone or merged with one neighbour, by two cuts into three good
+                //    blocks; merged with two neighbours, by one or two cuts
+                Attempt::Resplit(host, t) => {
+                    self.apply_resplit(&mut slot, &mut owner, &mut alive, k, (host, t));
+                    changed = true;
+                }
+                Attempt::Fail => {
                     if failed.len() <= k {
-                        failed.resize(k + 1, None);
+                        failed.resize_with(k + 1, || None);
                     }
-                    failed[k] = Some(print);
+                    failed[k] = Some(nb);
                     k += 1;
                 }
             }
