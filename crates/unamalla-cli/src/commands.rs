@@ -172,6 +172,12 @@ pub struct MeshArgs {
     /// (the shape pass moves interior nodes only).
     #[arg(long)]
     pub no_slide: bool,
+    /// Never drop holes: by default, when the mesh fails next to a hole narrower than the
+    /// cell size, it is made again without the holes narrower than a cell (listed in
+    /// report.json's "holes_dropped", with a warning); with this flag the run fails instead,
+    /// naming the hole.
+    #[arg(long)]
+    pub keep_narrow_holes: bool,
     /// When the automatically chosen layout gives μ ≥ 0.8 on fewer than this share of the
     /// cells (percent), re-make the mesh from the next candidate layouts (at most two more
     /// runs) and keep the best; 0 turns the retry off. Each try is named in report.json's
@@ -366,7 +372,9 @@ fn mesh_part(
     if !(a.quality_target.is_finite() && (0.0..=100.0).contains(&a.quality_target)) {
         bail!("--quality-target must be a percentage between 0 and 100");
     }
-    mesher = mesher.quality_target(a.quality_target);
+    mesher = mesher
+        .quality_target(a.quality_target)
+        .drop_narrow_holes(!a.keep_narrow_holes);
     let mut sopts = SimplifyOptions::default();
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);
@@ -396,6 +404,13 @@ fn mesh_part(
         p.finish();
     }
     let result = result.with_context(|| format!("{name}: nothing written"))?;
+    // dropping holes changes the domain: said on stderr even with --quiet
+    if !result.report.holes_dropped.is_empty() && a.min_hole_area.is_none() {
+        eprintln!(
+            "warning: {name}: {} hole(s) narrower than the cell size were dropped (report.json \"holes_dropped\"); --keep-narrow-holes fails instead, a smaller --cell-size keeps them",
+            result.report.holes_dropped.len()
+        );
+    }
     let mut report = result.report.clone();
     report.region = name.to_string();
     let mut not_met = reliability::guarantee(&report.verification, true, name)?;

@@ -1364,15 +1364,17 @@ fn issue_examples_and_hang_cases() {
             &["meshable gap", "drop --no-simplify"],
         ),
         // decomposed, but 3 folded cells among the 0.4-wide holes at the cell size 0.63
-        // (docs/reliability.md): refused, and the message names a hole narrower than a cell,
-        // the count of such holes and the two remedies (exit 1: an input the size cannot mesh)
+        // (docs/reliability.md): with --keep-narrow-holes refused, and the message names a hole
+        // narrower than a cell, the count of such holes and the two remedies (exit 1: an input
+        // the size cannot mesh)
         case(
-            "500 holes at 20000 cells",
+            "500 holes at 20000 cells, --keep-narrow-holes",
             &[
                 "mesh",
                 &p(hostile("holes-500.geojson")),
                 "--cells",
                 "20000",
+                "--keep-narrow-holes",
                 "-o",
                 "{out}",
                 "--quiet",
@@ -1384,6 +1386,26 @@ fn issue_examples_and_hang_cases() {
                 "499 other hole(s)",
                 "--min-hole-area",
                 "not convex",
+            ],
+        ),
+        // by default the same run is made again without the holes narrower than a cell (all
+        // 500 here) and says so on stderr even with --quiet (exit 0; the pipeline's own check
+        // ran on the region without them)
+        case(
+            "500 holes at 20000 cells, narrow holes dropped",
+            &[
+                "mesh",
+                &p(hostile("holes-500.geojson")),
+                "--cells",
+                "20000",
+                "-o",
+                "{out}",
+                "--quiet",
+            ],
+            0,
+            &[
+                "warning:",
+                "500 hole(s) narrower than the cell size were dropped",
             ],
         ),
         // holes 1e-6 apart at 2000 cells: meshed since the layout merges (thin convex cells in

@@ -95,8 +95,8 @@ pub use necks::{cut_narrow_necks, NeckCut, NeckKind, NeckOptions};
 pub use noise::{detect_noise, detect_noise_region, log_area_profile, NoiseReport};
 pub use overlay::overlay_svg;
 pub use simplify::{
-    hausdorff, remove_features_below, simplify_region, subset_hausdorff, DroppedHole, HoleFilter,
-    Method, Preset, RingReport, SimplifyOptions, SimplifyResult, SubsetHausdorff,
+    hausdorff, hole_width, remove_features_below, simplify_region, subset_hausdorff, DroppedHole,
+    HoleFilter, Method, Preset, RingReport, SimplifyOptions, SimplifyResult, SubsetHausdorff,
 };
 
 /// Absolute shoelace area of an open ring.

@@ -181,6 +181,18 @@ pub enum HoleFilter {
     MinArea(f64),
     /// Drop holes whose area is below this fraction of the outer ring's area.
     MinAreaFraction(f64),
+    /// Drop holes narrower than this (region units): the smaller side of the hole's
+    /// axis-aligned bounding box is below it (what `unamalla_core`'s failure analysis calls a
+    /// hole narrower than a cell).
+    MinWidth(f64),
+}
+
+/// The width [`HoleFilter::MinWidth`] compares: the smaller side of the ring's axis-aligned
+/// bounding box.
+pub fn hole_width(hole: &unamalla_mesh::Polygon) -> f64 {
+    let (lo, hi) = hole.bounding_box();
+    let d = hi - lo;
+    d.x.min(d.y)
 }
 
 /// Options of [`simplify_region`]. `Default` is modified areas with the clean preset (ε = 1),
@@ -319,15 +331,18 @@ pub fn simplify_region(
     };
     // hole filter
     let outer_area = region.outer().area();
-    let min_area = match opts.holes {
-        HoleFilter::KeepAll => 0.0,
-        HoleFilter::MinArea(a) => check_param("min_hole_area", a)?,
-        HoleFilter::MinAreaFraction(f) => check_param("min_hole_area_fraction", f)? * outer_area,
+    let (min_area, min_width) = match opts.holes {
+        HoleFilter::KeepAll => (0.0, 0.0),
+        HoleFilter::MinArea(a) => (check_param("min_hole_area", a)?, 0.0),
+        HoleFilter::MinAreaFraction(f) => {
+            (check_param("min_hole_area_fraction", f)? * outer_area, 0.0)
+        }
+        HoleFilter::MinWidth(w) => (0.0, check_param("min_hole_width", w)?),
     };
     let mut kept: Vec<usize> = Vec::new();
     let mut dropped_holes = Vec::new();
     for (k, h) in region.holes().iter().enumerate() {
-        if h.area() < min_area {
+        if h.area() < min_area || hole_width(h) < min_width {
             dropped_holes.push(DroppedHole {
                 hole: k,
                 area: h.area(),

@@ -208,6 +208,29 @@ fn small_holes_are_dropped_and_reported() {
     assert!((res.relative_area_change - 1.0 / 9599.0).abs() < 1e-15);
 }
 
+/// `HoleFilter::MinWidth`: a hole is dropped when the smaller side of its bounding box is
+/// below the width — here a 30 × 0.5 slit (width 0.5, area 15) goes at width 1 although it is
+/// larger than the 1 × 1 square (width 1, kept: not below 1) and the 20 × 20 square.
+#[test]
+fn narrow_holes_are_dropped_by_width_not_area() {
+    let outer = dense_square(DVec2::ZERO, 100.0, 4);
+    let rev = |r: Vec<DVec2>| r.into_iter().rev().collect::<Vec<_>>();
+    let big = rev(dense_square(v(10., 10.), 20.0, 2));
+    let unit = rev(dense_square(v(60., 60.), 1.0, 1));
+    let slit = vec![v(40., 80.), v(40., 80.5), v(70., 80.5), v(70., 80.)];
+    let region = Region::new(outer, vec![big, unit, slit]).unwrap();
+    assert_eq!(unamalla_contour::hole_width(&region.holes()[2]), 0.5);
+    let mut o = opts(Method::ModifiedAreas);
+    o.holes = HoleFilter::MinWidth(1.0);
+    let res = simplify_region(&region, &o).unwrap();
+    assert_eq!(res.dropped_holes.len(), 1);
+    assert_eq!(res.dropped_holes[0].hole, 2);
+    assert_eq!(res.dropped_holes[0].area, 15.0);
+    assert_eq!(res.region.holes().len(), 2);
+    o.holes = HoleFilter::MinWidth(f64::NAN);
+    assert!(simplify_region(&region, &o).is_err());
+}
+
 #[test]
 fn a_removal_that_would_swallow_a_hole_is_skipped() {
     // outer square with a long shallow bump on top; a hole sits in the bump, above the chord

@@ -62,7 +62,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 use unamalla_compat_ilp as ilp;
-use unamalla_contour::{remove_features_below, simplify_region, SimplifyOptions};
+use unamalla_contour::{remove_features_below, simplify_region, HoleFilter, SimplifyOptions};
 use unamalla_decompose::submap::{prefers_submap, submap, SubmapOptions, Submapping};
 use unamalla_decompose::{
     chord_layout_cuts, decompose, layout_from_cuts, split_chord, DecomposeOptions, Decomposition,
@@ -192,6 +192,7 @@ pub struct Mesher {
     coarse_levels: usize,
     shape: Option<ShapeOptions>,
     quality_target: f64,
+    drop_narrow_holes: bool,
     /// Candidate layouts [`choose_layout`] must not pick (set by the fallback of
     /// [`Mesher::mesh_observed`] after a layout failed the guarantee).
     excluded_layouts: Vec<String>,
@@ -302,6 +303,7 @@ impl Mesher {
             coarse_levels: crate::multilevel::DEFAULT_COARSE_LEVELS,
             shape: Some(ShapeOptions::default()),
             quality_target: QUALITY_TARGET_PERCENT,
+            drop_narrow_holes: true,
             excluded_layouts: Vec::new(),
         }
     }
@@ -349,6 +351,20 @@ impl Mesher {
         } else {
             0.0
         };
+        self
+    }
+    /// Whether a mesh that fails the guarantee next to holes narrower than the cell size `h`
+    /// is made again without every hole narrower than `h` (default `true`). Cells of size `h`
+    /// cannot go around an island narrower than one of them: the block layout gives it its
+    /// own blocks, a cell or two across, and the untangling cannot always open them. The
+    /// retry runs only when the hole filter of the simplification is [`HoleFilter::KeepAll`]
+    /// (a filter the user set is kept as it is) and the failure lies next to such a hole
+    /// ([`crate::preflight::small_hole`]); it uses [`HoleFilter::MinWidth`]`(h)`, the dropped
+    /// holes are listed in [`MeshReport::holes_dropped`] and the report's notes say why. With
+    /// `false` the run fails with the error naming the hole and the remedies (a smaller cell
+    /// size keeps the holes).
+    pub fn drop_narrow_holes(mut self, yes: bool) -> Self {
+        self.drop_narrow_holes = yes;
         self
     }
     /// About `n` cells.
@@ -621,9 +637,70 @@ impl Mesher {
                 v = rv;
             }
         }
+        // holes narrower than a cell: with the default hole filter, a failure next to such a
+        // hole is meshed again without every hole narrower than h ([`Mesher::drop_narrow_holes`])
+        if !allow && !v.passed() && self.drop_narrow_holes && h > 0.0 {
+            let default_filter = self
+                .simplify
+                .as_ref()
+                .is_some_and(|o| o.holes == HoleFilter::KeepAll);
+            let narrow = region
+                .holes()
+                .iter()
+                .filter(|hole| unamalla_contour::hole_width(hole) < h)
+                .count();
+            if default_filter && narrow > 0 && preflight::small_hole(&v, region, h).is_some() {
+                let note = format!(
+                    "the mesh keeping every hole failed the guarantee next to a hole narrower than the cell size {h:.4e}; made again without the {narrow} hole(s) narrower than that (a cell size of at most half their width keeps them)"
+                );
+                self.stage(Stage::Decompose, &note);
+                if let Some(o) = self.simplify.as_mut() {
+                    o.holes = HoleFilter::MinWidth(h);
+                }
+                self.excluded_layouts.clear();
+                if let Ok(retry) = self.mesh_unverified(region, observer) {
+                    let rv = verify(&retry);
+                    let mut rv_last = (
+                        retry.report.layout.as_ref().map(|c| c.layout.clone()),
+                        bad_cells(&rv),
+                    );
+                    let mut retry = retry;
+                    let mut rv = rv;
+                    // the layout fallback once more, on the region without those holes
+                    let mut tries = 0;
+                    while !rv.passed() && rv_last.1 > 0 && tries < LAYOUT_FALLBACKS {
+                        let Some(name) = rv_last.0.take() else {
+                            break;
+                        };
+                        tries += 1;
+                        self.excluded_layouts.push(name);
+                        let Ok(again) = self.mesh_unverified(region, observer) else {
+                            break;
+                        };
+                        let av = verify(&again);
+                        rv_last = (
+                            again.report.layout.as_ref().map(|c| c.layout.clone()),
+                            bad_cells(&av),
+                        );
+                        if av.passed() || bad_cells(&av) < bad_cells(&rv) {
+                            retry = again;
+                            rv = av;
+                        }
+                    }
+                    if rv.passed() {
+                        failed.push(note);
+                        result = retry;
+                        v = rv;
+                        last = rv_last;
+                    }
+                }
+            }
+        }
         // quality fallback: a mesh that passed but is below the quality target is re-made from
         // the next candidate layouts (best predicted first), keeping the best achieved share
         let mut quality_tries = 0;
+        // the share of the last attempt (the kept one may be an earlier one)
+        let mut last_share = result.report.mu_ge_0_8_percent;
         while !allow
             && self.quality_target > 0.0
             && v.passed()
@@ -635,8 +712,8 @@ impl Mesher {
             };
             quality_tries += 1;
             let note = format!(
-                "layout {name} reached μ ≥ 0.8 on {:.1} % of the cells, below the target {} %; re-made from the next candidate layout",
-                result.report.mu_ge_0_8_percent, self.quality_target
+                "layout {name} reached μ ≥ 0.8 on {last_share:.1} % of the cells, below the target {} %; re-made from the next candidate layout",
+                self.quality_target
             );
             self.stage(Stage::Decompose, &note);
             failed.push(note);
@@ -651,6 +728,7 @@ impl Mesher {
                 bad_cells(&rv),
             );
             let share = retry.report.mu_ge_0_8_percent;
+            last_share = share;
             failed.push(format!(
                 "layout {} reached μ ≥ 0.8 on {share:.1} % ({})",
                 last.0.as_deref().unwrap_or("?"),

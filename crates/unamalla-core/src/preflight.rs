@@ -188,8 +188,7 @@ pub struct SmallHole {
 /// The width of `hole` for [`SmallHole`]: the smaller side of its bounding box.
 fn hole_width(hole: &unamalla_mesh::Polygon) -> (f64, DVec2) {
     let (lo, hi) = hole.bounding_box();
-    let d = hi - lo;
-    (d.x.min(d.y), 0.5 * (lo + hi))
+    (unamalla_contour::hole_width(hole), 0.5 * (lo + hi))
 }
 
 /// The hole next to which the failing cells of `v` lie when it is narrower than the cell size
