@@ -16,7 +16,7 @@ use crate::error::OptimError;
 use crate::linalg::{
     add_scaled, axpy, dot, inv3_spd, norm, scale_add, PrecondApply, Preconditioner,
 };
-use crate::linesearch::{more_thuente, LineSearchParams};
+use crate::linesearch::{more_thuente, LineSearchParams, LineSearchResult};
 use crate::monitor::{Control, Session};
 use crate::status::{LineSearchFailure, StopReason};
 
@@ -892,39 +892,25 @@ fn truncated_newton<P: Problem + ?Sized>(
                 w.z.iter_mut().for_each(|v| *v = -*v);
                 gd = dot(g, &w.z);
             }
-            let d = &w.z;
-            let smax = if guard {
-                0.95 * session.max_step(problem, xr, d)
-            } else {
-                f64::INFINITY
-            };
-            truncated = smax < 1.0;
-            let lsp = LineSearchParams {
-                stpmax: opts.line_search.stpmax.min(smax),
-                ..opts.line_search
-            };
-            let mut fe = 0;
-            let r = more_thuente(
-                |t| {
-                    fe += 1;
-                    add_scaled(xr, t, d, &mut xt);
-                    if guard && !session.admissible(problem, &xt) {
-                        return None;
-                    }
-                    let f = problem.value_grad(&xt, &mut gt);
-                    Some((f, dot(&gt, d)))
-                },
-                st.f,
+            let search = guarded_line_search(
+                problem,
+                xr,
+                &w.z,
                 gd,
-                1.0f64.min(lsp.stpmax),
-                &lsp,
+                1.0,
+                guard,
+                &opts.line_search,
+                session,
+                st,
+                (&mut xt, &mut gt),
             );
-            st.fevals += fe;
-            if r.stp == 0.0 {
-                break 'outer StopReason::LineSearch(
-                    r.warning.unwrap_or(LineSearchFailure::Rounding),
-                );
-            }
+            let r = match search {
+                Ok((r, cut)) => {
+                    truncated = cut;
+                    r
+                }
+                Err(reason) => break 'outer reason,
+            };
             f_acc = r.f;
         }
         cg_last = st.cg - cg_before;
@@ -997,37 +983,21 @@ fn lbfgs<P: Problem + ?Sized>(
             head = 0;
         }
         let guard = session.guard_active(st.cur_min);
-        let xr: &[f64] = x;
-        let smax = if guard {
-            0.95 * session.max_step(problem, xr, &d)
-        } else {
-            f64::INFINITY
-        };
-        let truncated = smax < stp0;
-        let lsp = LineSearchParams {
-            stpmax: opts.line_search.stpmax.min(smax),
-            ..opts.line_search
-        };
-        let mut fe = 0;
-        let r = more_thuente(
-            |t| {
-                fe += 1;
-                add_scaled(xr, t, &d, &mut xt);
-                if guard && !session.admissible(problem, &xt) {
-                    return None;
-                }
-                let f = problem.value_grad(&xt, &mut gt);
-                Some((f, dot(&gt, &d)))
-            },
-            st.f,
+        let (r, truncated) = match guarded_line_search(
+            problem,
+            x,
+            &d,
             gd,
-            stp0.min(lsp.stpmax),
-            &lsp,
-        );
-        st.fevals += fe;
-        if r.stp == 0.0 {
-            return StopReason::LineSearch(r.warning.unwrap_or(LineSearchFailure::Rounding));
-        }
+            stp0,
+            guard,
+            &opts.line_search,
+            session,
+            st,
+            (&mut xt, &mut gt),
+        ) {
+            Ok(found) => found,
+            Err(reason) => return reason,
+        };
         // new pair
         let mut s = vec![0.0; n];
         add_scaled(&xt, -1.0, x, &mut s);
@@ -1053,6 +1023,62 @@ fn lbfgs<P: Problem + ?Sized>(
             return reason;
         }
     }
+}
+
+/// One Moré–Thuente line search along `d` from `x` under the convexity guard (the search of
+/// the line-search solvers: truncated Newton with a line search, L-BFGS, NCG). With the guard
+/// active (`guard`, from [`Session::guard_active`]) the step is capped at 0.95 of the largest
+/// step that keeps every element admissible and a trial point that is not admissible counts as
+/// infeasible. `trial` (point, gradient) receives the last trial, the accepted one on success.
+/// Returns the search's result and whether the cap was below the first trial step `stp0`, or
+/// the stop reason when no step was accepted.
+#[allow(clippy::too_many_arguments)]
+fn guarded_line_search<P: Problem + ?Sized>(
+    problem: &P,
+    x: &[f64],
+    d: &[f64],
+    gd: f64,
+    stp0: f64,
+    guard: bool,
+    params: &LineSearchParams,
+    session: &mut Session<'_>,
+    st: &mut State,
+    trial: (&mut [f64], &mut [f64]),
+) -> Result<(LineSearchResult, bool), StopReason> {
+    let (xt, gt) = trial;
+    let smax = if guard {
+        0.95 * session.max_step(problem, x, d)
+    } else {
+        f64::INFINITY
+    };
+    let truncated = smax < stp0;
+    let lsp = LineSearchParams {
+        stpmax: params.stpmax.min(smax),
+        ..*params
+    };
+    let mut fe = 0;
+    let r = more_thuente(
+        |t| {
+            fe += 1;
+            add_scaled(x, t, d, xt);
+            if guard && !session.admissible(problem, xt) {
+                return None;
+            }
+            let f = problem.value_grad(xt, gt);
+            Some((f, dot(gt, d)))
+        },
+        st.f,
+        gd,
+        stp0.min(lsp.stpmax),
+        &lsp,
+    );
+    st.fevals += fe;
+    if r.stp == 0.0 {
+        return Err(StopReason::LineSearch(
+            r.warning.unwrap_or(LineSearchFailure::Rounding),
+        ));
+    }
+    Ok((r, truncated))
 }
 
 /// Curvature constant of the strong-Wolfe line search of [`Solver::NcgFr`] (at most this; the
@@ -1090,38 +1116,25 @@ fn ncg_fr<P: Problem + ?Sized>(
             None => 1.0 / st.gnorm,
         };
         let guard = session.guard_active(st.cur_min);
-        let xr: &[f64] = x;
-        let smax = if guard {
-            0.95 * session.max_step(problem, xr, &d)
-        } else {
-            f64::INFINITY
-        };
-        let truncated = smax < stp0;
-        let lsp = LineSearchParams {
-            stpmax: opts.line_search.stpmax.min(smax),
+        let wolfe = LineSearchParams {
             gtol: opts.line_search.gtol.min(NCG_WOLFE_GTOL),
             ..opts.line_search
         };
-        let mut fe = 0;
-        let r = more_thuente(
-            |t| {
-                fe += 1;
-                add_scaled(xr, t, &d, &mut xt);
-                if guard && !session.admissible(problem, &xt) {
-                    return None;
-                }
-                let f = problem.value_grad(&xt, &mut gt);
-                Some((f, dot(&gt, &d)))
-            },
-            st.f,
+        let (r, truncated) = match guarded_line_search(
+            problem,
+            x,
+            &d,
             gd,
-            stp0.min(lsp.stpmax),
-            &lsp,
-        );
-        st.fevals += fe;
-        if r.stp == 0.0 {
-            return StopReason::LineSearch(r.warning.unwrap_or(LineSearchFailure::Rounding));
-        }
+            stp0,
+            guard,
+            &wolfe,
+            session,
+            st,
+            (&mut xt, &mut gt),
+        ) {
+            Ok(found) => found,
+            Err(reason) => return reason,
+        };
         let g_old2 = dot(g, g);
         x.copy_from_slice(&xt);
         g.copy_from_slice(&gt);

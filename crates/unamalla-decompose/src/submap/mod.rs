@@ -452,21 +452,7 @@ pub fn submap(region: &Region, options: &SubmapOptions) -> Result<Submapping, Su
         let merged = virtual_edges::connect(region, rings, h, &banned)?;
         let edges: Vec<(DVec2, DVec2)> = merged.edges.iter().map(|e| (e.a, e.b)).collect();
         match finish(merged, options) {
-            Ok((comp, pieces, cuts, nodes, node_kinds, virtual_edges, merged_repaired)) => {
-                return Ok(Submapping {
-                    classification,
-                    attempts: attempt,
-                    virtual_edges,
-                    merged_repaired,
-                    edges: comp.edges,
-                    interval_objective: comp.objective,
-                    nodes,
-                    node_kinds,
-                    comp_loop: comp.occurrences.iter().map(|o| (o.id, o.c)).collect(),
-                    cuts,
-                    pieces,
-                });
-            }
+            Ok(done) => return Ok(assemble(classification, attempt, done)),
             Err(e) if !edges.is_empty() && attempt < options.max_attempts && retryable(&e) => {
                 banned.extend(edges);
             }
@@ -499,6 +485,24 @@ type Finished = (
     Vec<VirtualEdge>,
     bool,
 );
+
+/// The [`Submapping`] of a classification and the result of steps 4–7.
+fn assemble(classification: Classification, attempts: usize, done: Finished) -> Submapping {
+    let (comp, pieces, cuts, nodes, node_kinds, virtual_edges, merged_repaired) = done;
+    Submapping {
+        classification,
+        attempts,
+        virtual_edges,
+        merged_repaired,
+        edges: comp.edges,
+        interval_objective: comp.objective,
+        nodes,
+        node_kinds,
+        comp_loop: comp.occurrences.iter().map(|o| (o.id, o.c)).collect(),
+        cuts,
+        pieces,
+    }
+}
 
 /// Steps 4–7 on a merged loop.
 fn finish(merged: virtual_edges::Merged, options: &SubmapOptions) -> Result<Finished, SubmapError> {

@@ -55,6 +55,20 @@ fn tangents(lp: &[LPoint], loc: Loc) -> (DVec2, DVec2) {
     }
 }
 
+/// The four turning angles a virtual edge `ab` (from `la` on the loop `current` to `lb` on
+/// `hole`) creates: at A entering the edge, at B entering the hole, at B leaving it, at A
+/// leaving the edge.
+fn junction_turnings(current: &[LPoint], la: Loc, hole: &[LPoint], lb: Loc, ab: DVec2) -> [f64; 4] {
+    let (ta_in, ta_out) = tangents(current, la);
+    let (tb_in, tb_out) = tangents(hole, lb);
+    [
+        turning_angle(ta_in, ab),
+        turning_angle(ab, tb_out),
+        turning_angle(tb_in, -ab),
+        turning_angle(-ab, ta_out),
+    ]
+}
+
 /// Inserts `p` (if it is not a loop point already) and returns its index.
 fn insert(lp: &mut Vec<LPoint>, p: DVec2, loc: Loc, key: &mut usize) -> usize {
     match loc {
@@ -245,15 +259,8 @@ pub(crate) fn connect(
             else {
                 continue;
             };
-            let (ta_in, ta_out) = tangents(&current, la);
-            let (tb_in, tb_out) = tangents(hole, lb);
             let ab = pb - pa;
-            let th = [
-                turning_angle(ta_in, ab),
-                turning_angle(ab, tb_out),
-                turning_angle(tb_in, -ab),
-                turning_angle(-ab, ta_out),
-            ];
+            let th = junction_turnings(&current, la, hole, lb, ab);
             let devs = th.map(right_deviation);
             let score: Score = (
                 devs.iter().copied().fold(0.0, f64::max),
@@ -419,15 +426,7 @@ pub(crate) fn connect_prescribed(
         else {
             return Err(SubmapError::NoVirtualEdge { hole: hole_id });
         };
-        let (ta_in, ta_out) = tangents(&current, la);
-        let (tb_in, tb_out) = tangents(&hole, lb);
-        let ab = pb - pa;
-        let th = [
-            turning_angle(ta_in, ab),
-            turning_angle(ab, tb_out),
-            turning_angle(tb_in, -ab),
-            turning_angle(-ab, ta_out),
-        ];
+        let th = junction_turnings(&current, la, &hole, lb, pb - pa);
         splice(
             &mut current,
             hole,

@@ -167,22 +167,9 @@ pub fn white_submap(
         }
         r => r?,
     };
-    let (comp, pieces, cuts, nodes, node_kinds, virtual_edges, merged_repaired) =
-        finish(merged, options)?;
+    let done = finish(merged, options)?;
     Ok(WhiteSubmapping {
-        submapping: Submapping {
-            classification,
-            attempts: 1,
-            virtual_edges,
-            merged_repaired,
-            edges: comp.edges,
-            interval_objective: comp.objective,
-            nodes,
-            node_kinds,
-            comp_loop: comp.occurrences.iter().map(|o| (o.id, o.c)).collect(),
-            cuts,
-            pieces,
-        },
+        submapping: super::assemble(classification, 1, done),
         outer_cells: s1.num_cells(),
         steps,
     })
