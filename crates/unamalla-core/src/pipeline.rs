@@ -602,41 +602,11 @@ impl Mesher {
         // re-made from the next candidate layout, best predicted first, at most
         // [`LAYOUT_FALLBACKS`] times; every attempt is named in the report's notes, and if none
         // passes, the attempt with the fewest such cells is the one reported
-        let bad_cells =
-            |v: &crate::verify::Verification| v.non_convex_cells + v.centroids_outside.unwrap_or(0);
         let mut failed: Vec<String> = Vec::new();
         // the layout and the bad cells of the last attempt (the kept one may be an earlier one)
-        let mut last = (
-            result.report.layout.as_ref().map(|c| c.layout.clone()),
-            bad_cells(&v),
-        );
-        while !allow && !v.passed() && last.1 > 0 && failed.len() < LAYOUT_FALLBACKS {
-            let (Some(name), bad) = (last.0.take(), last.1) else {
-                break;
-            };
-            let note = format!(
-                "layout {name} left {bad} cell(s) non-convex or outside the region; re-made from the next candidate layout"
-            );
-            self.stage(Stage::Decompose, &note);
-            failed.push(note);
-            self.excluded_layouts.push(name);
-            let retry = match self.mesh_unverified(region, observer) {
-                Ok(r) => r,
-                // no candidate left, or the next one fails in a stage: keep what we have
-                Err(_) => break,
-            };
-            let rv = verify(&retry);
-            last = (
-                retry.report.layout.as_ref().map(|c| c.layout.clone()),
-                bad_cells(&rv),
-            );
-            // keep the attempt with the fewest bad cells (the earlier on a tie); a passing retry
-            // always replaces a failing one
-            if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
-                result = retry;
-                v = rv;
-            }
-        }
+        let mut last;
+        ((result, v), last) =
+            self.layout_fallback(region, observer, &verify, (result, v), &mut failed);
         // holes narrower than a cell: with the default hole filter, a failure next to such a
         // hole is meshed again without every hole narrower than h ([`Mesher::drop_narrow_holes`])
         if !allow && !v.passed() && self.drop_narrow_holes && h > 0.0 {
@@ -660,35 +630,12 @@ impl Mesher {
                 self.excluded_layouts.clear();
                 if let Ok(retry) = self.mesh_unverified(region, observer) {
                     let rv = verify(&retry);
-                    let mut rv_last = (
-                        retry.report.layout.as_ref().map(|c| c.layout.clone()),
-                        bad_cells(&rv),
-                    );
-                    let mut retry = retry;
-                    let mut rv = rv;
                     // the layout fallback once more, on the region without those holes
-                    let mut tries = 0;
-                    while !rv.passed() && rv_last.1 > 0 && tries < LAYOUT_FALLBACKS {
-                        let Some(name) = rv_last.0.take() else {
-                            break;
-                        };
-                        tries += 1;
-                        self.excluded_layouts.push(name);
-                        let Ok(again) = self.mesh_unverified(region, observer) else {
-                            break;
-                        };
-                        let av = verify(&again);
-                        rv_last = (
-                            again.report.layout.as_ref().map(|c| c.layout.clone()),
-                            bad_cells(&av),
-                        );
-                        if av.passed() || bad_cells(&av) < bad_cells(&rv) {
-                            retry = again;
-                            rv = av;
-                        }
-                    }
+                    let mut notes = vec![note];
+                    let ((retry, rv), rv_last) =
+                        self.layout_fallback(region, observer, &verify, (retry, rv), &mut notes);
                     if rv.passed() {
-                        failed.push(note);
+                        failed.append(&mut notes);
                         result = retry;
                         v = rv;
                         last = rv_last;
@@ -757,6 +704,58 @@ impl Mesher {
                 .map_err(|e| preflight::explain_guarantee(e, region, h))?;
         }
         Ok(result)
+    }
+
+    /// The layout fallback of [`Mesher::mesh_observed`]: while the kept attempt `best` fails
+    /// the guarantee with non-convex cells or cells outside the region, the mesh is re-made from
+    /// the next candidate layout (the last attempt's layout excluded), at most
+    /// [`LAYOUT_FALLBACKS`] times, each named in `notes`; the attempt with the fewest such cells
+    /// is kept (the earlier on a tie; a passing one always). Returns the kept attempt and the
+    /// layout and bad-cell count of the last one.
+    fn layout_fallback(
+        &mut self,
+        region: &Region,
+        observer: &mut dyn Observer,
+        verify: &dyn Fn(&MeshResult) -> crate::verify::Verification,
+        best: (MeshResult, crate::verify::Verification),
+        notes: &mut Vec<String>,
+    ) -> (
+        (MeshResult, crate::verify::Verification),
+        (Option<String>, usize),
+    ) {
+        let (mut result, mut v) = best;
+        let mut last = (
+            result.report.layout.as_ref().map(|c| c.layout.clone()),
+            bad_cells(&v),
+        );
+        let mut tries = 0;
+        while !self.allow_non_convex && !v.passed() && last.1 > 0 && tries < LAYOUT_FALLBACKS {
+            let (Some(name), bad) = (last.0.take(), last.1) else {
+                break;
+            };
+            tries += 1;
+            let note = format!(
+                "layout {name} left {bad} cell(s) non-convex or outside the region; re-made from the next candidate layout"
+            );
+            self.stage(Stage::Decompose, &note);
+            notes.push(note);
+            self.excluded_layouts.push(name);
+            let retry = match self.mesh_unverified(region, observer) {
+                Ok(r) => r,
+                // no candidate left, or the next one fails in a stage: keep what we have
+                Err(_) => break,
+            };
+            let rv = verify(&retry);
+            last = (
+                retry.report.layout.as_ref().map(|c| c.layout.clone()),
+                bad_cells(&rv),
+            );
+            if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
+                result = retry;
+                v = rv;
+            }
+        }
+        ((result, v), last)
     }
 
     /// The pipeline without the checks of [`Mesher::mesh_observed`].
@@ -1183,6 +1182,12 @@ pub const DEFAULT_STOP_RULES: unamalla_optim::StopRules = unamalla_optim::StopRu
     plateau_alpha: 0.01,
     plateau_share: 0.05,
 };
+
+/// The cells a layout fallback counts against an attempt: non-convex, or with the centroid
+/// outside the region.
+fn bad_cells(v: &crate::verify::Verification) -> usize {
+    v.non_convex_cells + v.centroids_outside.unwrap_or(0)
+}
 
 fn polygon_area(p: &[DVec2]) -> f64 {
     unamalla_mesh::region::signed_area(p)
