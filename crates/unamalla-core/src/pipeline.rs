@@ -662,18 +662,12 @@ impl Mesher {
                 "layout {name} reached μ ≥ 0.8 on {last_share:.1} % of the cells, below the target {} %; re-made from the next candidate layout",
                 self.quality_target
             );
-            self.stage(Stage::Decompose, &note);
-            failed.push(note);
-            self.excluded_layouts.push(name);
-            let retry = match self.mesh_unverified(region, observer) {
-                Ok(r) => r,
-                Err(_) => break,
+            let Some((retry, rv)) =
+                self.remake_excluding(name, note, &mut failed, region, observer, &verify)
+            else {
+                break;
             };
-            let rv = verify(&retry);
-            last = (
-                retry.report.layout.as_ref().map(|c| c.layout.clone()),
-                bad_cells(&rv),
-            );
+            last = (layout_name(&retry), bad_cells(&rv));
             let share = retry.report.mu_ge_0_8_percent;
             last_share = share;
             failed.push(format!(
@@ -724,10 +718,7 @@ impl Mesher {
         (Option<String>, usize),
     ) {
         let (mut result, mut v) = best;
-        let mut last = (
-            result.report.layout.as_ref().map(|c| c.layout.clone()),
-            bad_cells(&v),
-        );
+        let mut last = (layout_name(&result), bad_cells(&v));
         let mut tries = 0;
         while !self.allow_non_convex && !v.passed() && last.1 > 0 && tries < LAYOUT_FALLBACKS {
             let (Some(name), bad) = (last.0.take(), last.1) else {
@@ -737,25 +728,39 @@ impl Mesher {
             let note = format!(
                 "layout {name} left {bad} cell(s) non-convex or outside the region; re-made from the next candidate layout"
             );
-            self.stage(Stage::Decompose, &note);
-            notes.push(note);
-            self.excluded_layouts.push(name);
-            let retry = match self.mesh_unverified(region, observer) {
-                Ok(r) => r,
-                // no candidate left, or the next one fails in a stage: keep what we have
-                Err(_) => break,
+            // no candidate left, or the next one fails in a stage: keep what we have
+            let Some((retry, rv)) =
+                self.remake_excluding(name, note, notes, region, observer, verify)
+            else {
+                break;
             };
-            let rv = verify(&retry);
-            last = (
-                retry.report.layout.as_ref().map(|c| c.layout.clone()),
-                bad_cells(&rv),
-            );
+            last = (layout_name(&retry), bad_cells(&rv));
             if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
                 result = retry;
                 v = rv;
             }
         }
         ((result, v), last)
+    }
+
+    /// One retry of the fallbacks of [`Mesher::mesh_observed`]: `note` goes to the progress
+    /// line and to `notes`, layout `name` is excluded, and the mesh is re-made from the next
+    /// candidate layout and verified; `None` when no candidate is left or a stage fails.
+    fn remake_excluding(
+        &mut self,
+        name: String,
+        note: String,
+        notes: &mut Vec<String>,
+        region: &Region,
+        observer: &mut dyn Observer,
+        verify: &dyn Fn(&MeshResult) -> crate::verify::Verification,
+    ) -> Option<(MeshResult, crate::verify::Verification)> {
+        self.stage(Stage::Decompose, &note);
+        notes.push(note);
+        self.excluded_layouts.push(name);
+        let retry = self.mesh_unverified(region, observer).ok()?;
+        let rv = verify(&retry);
+        Some((retry, rv))
     }
 
     /// The pipeline without the checks of [`Mesher::mesh_observed`].
@@ -1182,6 +1187,11 @@ pub const DEFAULT_STOP_RULES: unamalla_optim::StopRules = unamalla_optim::StopRu
     plateau_alpha: 0.01,
     plateau_share: 0.05,
 };
+
+/// The automatically chosen layout of a mesh (`None`: the layout was given).
+fn layout_name(result: &MeshResult) -> Option<String> {
+    result.report.layout.as_ref().map(|c| c.layout.clone())
+}
 
 /// The cells a layout fallback counts against an attempt: non-convex, or with the centroid
 /// outside the region.
