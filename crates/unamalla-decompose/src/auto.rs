@@ -9,11 +9,16 @@ use rayon::prelude::*;
 
 use unamalla_mesh::{DVec2, Region};
 
-use crate::concavity::{concavity, Tolerances};
-use crate::corners::{quad_fit, select_corners, triangle_rule, CornerWeights, TriangleBlock};
+use crate::concavity::{concavity, concavity_with_angles, Tolerances};
+use crate::corners::{
+    quad_fit, quad_fit_with_angles, select_corners, triangle_rule, CornerWeights, TriangleBlock,
+};
 use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
 use crate::error::DecomposeError;
-use crate::geom::{angle_penalty, left_angle, perimeter, project_t, ray_segment, ring_angle};
+use crate::geom::{
+    angle_penalty, left_angle, perimeter, project_t, ray_segment, ring_angle, ring_angles,
+    ring_angles_from,
+};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
 
@@ -443,6 +448,62 @@ pub(crate) struct Builder<'a> {
     /// Work shared with the other builders of one region and option set (the rebuilds of
     /// [`chord_layout_cuts`]); `None`: nothing is cached.
     pub(crate) cache: Option<Arc<LayoutCache>>,
+    /// [`AngleScreen`]s of the angle limits of [`Builder::angle_terms`]'s tiers 0–1, 2 and 3.
+    screens: [AngleScreen; 3],
+}
+
+/// A test deciding cheaply, for some vertex chains, that [`left_angle`] is below a limit λ or
+/// above π + 10⁻⁹ — decisions that [`Builder::angle_terms`] would reach from the `atan2`
+/// angle — and nothing otherwise.
+///
+/// `left_angle(prev, cur, next)` is `atan2(y, x)` (plus 2π when that is ≤ 0) for
+/// `y = u.perp_dot(v)`, `x = u.dot(v)`, `u = next − cur`, `v = prev − cur`; the test reads the
+/// same `y` and `x`. Below λ (0 < λ < 1.4): `y > 0`, `x > 0` and `r = fl(y/x)` in
+/// `[10⁻²⁰⁰, tan λ·(1 − 10⁻⁹))`. Then `y/x` is within 2⁻⁵² of `r` (relative), so the true
+/// angle `atan(y/x)` is at least 10⁻²⁰⁰·(1 − 10⁻¹⁵) and at least 10⁻¹⁰·λ below λ — far more
+/// than the error of `atan2` and of `tan` (a few units in the last place): the computed angle
+/// is in `(0, λ)` as well. Above π + 10⁻⁹: `y < 0` and either `x ≥ 0` (the computed `atan2`
+/// is in `[−π/2, 0]`, so the angle is at least 3π/2 less a rounding) or `x < 0` with
+/// `fl(y/x) > 10⁻⁶` (the true `atan2(y, x)` = −π + atan(y/x) is at least −π + 10⁻⁶·(1 − 10⁻⁶),
+/// so the computed angle, `atan2 + 2π`, is above π + 10⁻⁹).
+#[derive(Clone, Copy, Debug)]
+struct AngleScreen {
+    /// tan λ·(1 − 10⁻⁹), or 0 (nothing is below) when λ is not in (0, 1.4).
+    tan_below: f64,
+}
+
+impl AngleScreen {
+    /// The screen of the angle limit λ = `limit` (radians).
+    fn new(limit: f64) -> Self {
+        let tan_below = if limit > 0.0 && limit < 1.4 {
+            limit.tan() * (1.0 - 1e-9)
+        } else {
+            0.0
+        };
+        Self { tan_below }
+    }
+
+    /// The `(y, x)` of `left_angle(prev, cur, next)` (see the type's documentation).
+    fn yx(prev: DVec2, cur: DVec2, next: DVec2) -> (f64, f64) {
+        let (u, v) = (next - cur, prev - cur);
+        (u.perp_dot(v), u.dot(v))
+    }
+
+    /// `true` only if `left_angle(prev, cur, next)` is below the limit.
+    fn surely_below(&self, prev: DVec2, cur: DVec2, next: DVec2) -> bool {
+        let (y, x) = Self::yx(prev, cur, next);
+        if !(y > 0.0 && x > 0.0) {
+            return false;
+        }
+        let r = y / x;
+        (1e-200..self.tan_below).contains(&r)
+    }
+
+    /// `true` only if `left_angle(prev, cur, next)` is above π + 10⁻⁹.
+    fn surely_reflex(prev: DVec2, cur: DVec2, next: DVec2) -> bool {
+        let (y, x) = Self::yx(prev, cur, next);
+        y < 0.0 && (x >= 0.0 || y / x > 1e-6)
+    }
 }
 
 impl<'a> Builder<'a> {
@@ -478,7 +539,14 @@ impl<'a> Builder<'a> {
             min_triangle: opts.min_triangle_fraction * region.area(),
             auto_repair: true,
             cache: None,
+            screens: Self::angle_screens(opts),
         }
+    }
+
+    /// The [`AngleScreen`]s of the tiers' angle limits ([`Builder::angle_terms`]).
+    fn angle_screens(opts: &DecomposeOptions) -> [AngleScreen; 3] {
+        let theta = opts.tolerances.theta_minus;
+        [theta, 0.5 * theta, 0.2 * theta].map(AngleScreen::new)
     }
 
     fn leaves(&self) -> usize {
@@ -669,6 +737,7 @@ impl<'a> Builder<'a> {
             min_triangle: self.min_triangle,
             auto_repair: self.auto_repair,
             cache: None,
+            screens: self.screens,
         };
         b.run_auto(0).ok()?;
         let run = Arc::new(LeafRun {
@@ -802,6 +871,21 @@ impl<'a> Builder<'a> {
     ) -> Option<(f64, f64)> {
         let p = piece.point(e1);
         let q = piece.point(e2);
+        // the candidates that a new angle surely below the limit (or, in tier 0, a reflex
+        // angle at `e1`) rejects are rejected before any `atan2` (exact: AngleScreen)
+        let screen = &self.screens[tier.saturating_sub(1).min(2)];
+        let (prev1, _, next1) = piece.chain(e1);
+        let (prev2, _, next2) = piece.chain(e2);
+        if screen.surely_below(q, p, next1)
+            || screen.surely_below(prev1, p, q)
+            || screen.surely_below(p, q, next2)
+            || screen.surely_below(prev2, q, p)
+            || (tier == 0
+                && (AngleScreen::surely_reflex(q, p, next1)
+                    || AngleScreen::surely_reflex(prev1, p, q)))
+        {
+            return None;
+        }
         let (a, b) = Self::end_angles(piece, e1, q);
         let (c, d) = Self::end_angles(piece, e2, p);
         let min = a.min(b).min(c).min(d);
@@ -1053,10 +1137,12 @@ impl<'a> Builder<'a> {
 
     /// Badness B(P) of a hole-free piece: its corner score F* if it is approximately convex
     /// (it will be a block), else 1 + κ₂ + κ₃ (it will be cut again).
-    fn badness(&self, ring: &[DVec2]) -> f64 {
-        let c = concavity(ring);
+    /// The ring's vertex angles are given (`angles[i]` = `ring_angle(ring, i)`), for the
+    /// concavity measures and the corner score.
+    fn badness_with_angles(&self, ring: &[DVec2], angles: &[f64]) -> f64 {
+        let c = concavity_with_angles(ring, angles);
         if c.approximately_convex(&self.opts.tolerances) {
-            quad_fit(ring)
+            quad_fit_with_angles(ring, angles)
         } else {
             1.0 + c.kappa2 + c.kappa3
         }
@@ -1066,10 +1152,10 @@ impl<'a> Builder<'a> {
     fn concavity_cut(&mut self, piece: &Piece) -> Option<(Piece, Piece, usize)> {
         let ring = &piece.outer;
         let n = ring.len();
-        let conc = concavity(&ring.pts);
+        let angle: Vec<f64> = ring_angles(&ring.pts);
+        let conc = concavity_with_angles(&ring.pts, &angle);
         let area = piece.area();
         let sq = area.sqrt();
-        let angle: Vec<f64> = (0..n).map(|i| ring_angle(&ring.pts, i)).collect();
         let mut starts: Vec<usize> = (0..n)
             .filter(|&i| angle[i] > PI && conc.point_kappa3[i] > 0.0)
             .collect();
@@ -1159,8 +1245,26 @@ impl<'a> Builder<'a> {
                     continue;
                 }
                 evaluated += 1;
-                let ba = self.badness(&a.outer.pts);
-                let bb = self.badness(&b.outer.pts);
+                // the children's vertex angles from the piece's where a vertex keeps its
+                // neighbours (exact, `ring_angles_from`): `a` starts at the cut's first end
+                // (vertex `i` of the piece), `b` at its second end (a vertex, or a point inside
+                // an edge followed by the edge's end)
+                let start_b = match c.e2.pos {
+                    Pos::Vertex(j) => j,
+                    Pos::OnEdge(e, _) => e + 1,
+                };
+                let start_a = match c.e1.pos {
+                    Pos::Vertex(i) => i,
+                    Pos::OnEdge(e, _) => e + 1,
+                };
+                let ba = self.badness_with_angles(
+                    &a.outer.pts,
+                    &ring_angles_from(&a.outer.pts, &ring.pts, &angle, start_a),
+                );
+                let bb = self.badness_with_angles(
+                    &b.outer.pts,
+                    &ring_angles_from(&b.outer.pts, &ring.pts, &angle, start_b),
+                );
                 let s = 0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre;
                 if best.as_ref().is_none_or(|b| s < b.0) {
                     best = Some((s, *c));

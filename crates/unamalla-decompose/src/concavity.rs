@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 use unamalla_mesh::geometry::{convex_hull, point_segment_distance};
 use unamalla_mesh::DVec2;
 
-use crate::geom::{diameter, perimeter, ring_angle, signed_area};
+use crate::geom::{diameter, perimeter, ring_angle, ring_angles, signed_area};
 
 /// Tolerances of the concavity criteria and the critical angle (thesis Obs 4.8, §4.1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -109,15 +109,26 @@ pub struct Concavity {
 /// Computes κ₁–κ₄, the pockets and the point concavities of a simple counter-clockwise ring
 /// (stored open). O(n log n + h²) with h the number of hull vertices.
 pub fn concavity(ring: &[DVec2]) -> Concavity {
+    if ring.len() < 3 {
+        return concavity_with_angles(ring, &[]);
+    }
+    concavity_with_angles(ring, &ring_angles(ring))
+}
+
+/// [`concavity`] with the ring's vertex angles given (`angles[i]` = `ring_angle(ring, i)`,
+/// [`ring_angles`]; ignored for fewer than three vertices). The same result bit for bit: the
+/// largest angle is folded over the same values in the same order.
+pub(crate) fn concavity_with_angles(ring: &[DVec2], angles: &[f64]) -> Concavity {
     let n = ring.len();
-    let mut hull = convex_hull(ring);
-    let mut point_kappa3 = vec![0.0; n];
-    let mut point_kappa4 = vec![0.0; n];
     let max_angle = if n < 3 {
         0.0
     } else {
-        (0..n).map(|i| ring_angle(ring, i)).fold(0.0, f64::max)
+        debug_assert_eq!(angles.len(), n);
+        angles.iter().copied().fold(0.0, f64::max)
     };
+    let mut hull = convex_hull(ring);
+    let mut point_kappa3 = vec![0.0; n];
+    let mut point_kappa4 = vec![0.0; n];
     if n < 3 || hull.len() < 3 {
         return Concavity {
             kappa1: 0.0,

@@ -35,7 +35,7 @@ use std::f64::consts::PI;
 use unamalla_mesh::DVec2;
 
 use crate::corners_diametral::{select_diametral, CornerChoice};
-use crate::geom::{angle_penalty, ring_angle};
+use crate::geom::{angle_penalty, ring_angle, ring_angles};
 
 /// Weights of the corner score F.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,11 +74,25 @@ pub fn select_corners(ring: &[DVec2], w: &CornerWeights) -> Option<([usize; 4], 
     if w.choice == CornerChoice::Diametral {
         return select_diametral(ring, w);
     }
+    if ring.len() < 4 {
+        return None;
+    }
+    select_corners_with_angles(ring, &ring_angles(ring), w)
+}
+
+/// [`select_corners`] for the scoring selection with the ring's vertex angles given
+/// (`angles[i]` = `ring_angle(ring, i)`, [`ring_angles`]): the same computation on the same
+/// values.
+pub(crate) fn select_corners_with_angles(
+    ring: &[DVec2],
+    angles: &[f64],
+    w: &CornerWeights,
+) -> Option<([usize; 4], f64)> {
     let n = ring.len();
     if n < 4 {
         return None;
     }
-    let angles: Vec<f64> = (0..n).map(|i| ring_angle(ring, i)).collect();
+    debug_assert_eq!(angles.len(), n);
     let preferred = w.max_corner_angle.min(w.corner_angle_limit);
     let mut cands: Vec<usize> = (0..n).filter(|&i| angles[i] < preferred).collect();
     if cands.len() < 4 {
@@ -169,20 +183,39 @@ pub fn select_corners(ring: &[DVec2], w: &CornerWeights) -> Option<([usize; 4], 
 /// of its best corner tuple (with a smaller candidate set), or for rings without four
 /// non-reflex vertices ½ + the mean angle penalty of its vertices.
 pub(crate) fn quad_fit(ring: &[DVec2]) -> f64 {
+    quad_fit_with_angles(ring, &ring_angles(ring))
+}
+
+/// [`quad_fit`] with the ring's vertex angles given (`angles[i]` = `ring_angle(ring, i)`,
+/// [`ring_angles`]): the same computation on the same values (`quad_fit` uses the scoring
+/// selection, so [`select_corners_with_angles`] is what it calls).
+pub(crate) fn quad_fit_with_angles(ring: &[DVec2], angles: &[f64]) -> f64 {
     let w = CornerWeights {
         candidates: 10,
         ..CornerWeights::default()
     };
-    match select_corners(ring, &w) {
+    debug_assert_eq!(w.choice, CornerChoice::Scoring);
+    match select_corners_with_angles(ring, angles, &w) {
         Some((_, f)) if ring.len() > 3 => f,
         _ => {
             let n = ring.len().max(1);
-            0.5 + (0..ring.len())
-                .map(|i| angle_penalty(ring_angle(ring, i)))
-                .sum::<f64>()
-                / n as f64
+            0.5 + angles.iter().map(|&a| angle_penalty(a)).sum::<f64>() / n as f64
         }
     }
+}
+
+/// Whether [`select_corners`] with the scoring selection finds a corner tuple, from the ring's
+/// vertex angles (`angles[i]` = `ring_angle(ring, i)`): exactly when the ring has four vertices
+/// and four candidates survive the θ_max filter or, failing that, the θ_lim filter — the
+/// exhaustive search over four or more candidates always keeps its first tuple.
+pub(crate) fn has_four_corners(angles: &[f64], w: &CornerWeights) -> bool {
+    if angles.len() < 4 {
+        return false;
+    }
+    let preferred = w.max_corner_angle.min(w.corner_angle_limit);
+    let limit = w.corner_angle_limit.min(PI);
+    angles.iter().filter(|&&a| a < preferred).count() >= 4
+        || angles.iter().filter(|&&a| a < limit).count() >= 4
 }
 
 /// New ring, origin edge of every ring vertex (`None` = old vertex), four corners.

@@ -27,6 +27,59 @@ pub(crate) fn ring_angle(ring: &[DVec2], i: usize) -> f64 {
     left_angle(ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n])
 }
 
+/// The left angles of all vertices of an open ring (`ring_angle` for each, in order): computed
+/// once and handed to the functions that would otherwise recompute them vertex by vertex.
+pub(crate) fn ring_angles(ring: &[DVec2]) -> Vec<f64> {
+    (0..ring.len()).map(|i| ring_angle(ring, i)).collect()
+}
+
+/// [`ring_angles`] of `ring`, taken from `src_angles` (the [`ring_angles`] of `src`) at every
+/// vertex whose predecessor, point and successor are bit for bit those of a vertex of `src`
+/// (then `ring_angle` would repeat the same computation on the same numbers) and computed
+/// elsewhere. `ring` is expected to follow `src` from index `start` on, with points inserted
+/// or left out (a child of a split); the match of each vertex is checked, so any `start`
+/// gives the exact result, a good one just finds more matches.
+pub(crate) fn ring_angles_from(
+    ring: &[DVec2],
+    src: &[DVec2],
+    src_angles: &[f64],
+    start: usize,
+) -> Vec<f64> {
+    let (n, m) = (ring.len(), src.len());
+    if m == 0 || src_angles.len() != m {
+        return ring_angles(ring);
+    }
+    let same =
+        |a: DVec2, b: DVec2| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits();
+    // the vertex of `src` matching each vertex of `ring` (`usize::MAX`: none)
+    let mut s = start % m;
+    let map: Vec<usize> = ring
+        .iter()
+        .map(|&p| {
+            if same(src[s], p) {
+                let k = s;
+                s = (s + 1) % m;
+                k
+            } else {
+                usize::MAX
+            }
+        })
+        .collect();
+    (0..n)
+        .map(|k| {
+            let j = map[k];
+            let reuse = j != usize::MAX
+                && same(src[(j + m - 1) % m], ring[(k + n - 1) % n])
+                && same(src[(j + 1) % m], ring[(k + 1) % n]);
+            if reuse {
+                src_angles[j]
+            } else {
+                ring_angle(ring, k)
+            }
+        })
+        .collect()
+}
+
 /// `true` if the point `x` lies strictly inside the open wedge on the left of the chain
 /// `prev → cur → next` (the region side at `cur`). Exact.
 pub(crate) fn in_wedge(prev: DVec2, cur: DVec2, next: DVec2, x: DVec2) -> bool {

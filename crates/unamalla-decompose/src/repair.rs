@@ -57,9 +57,11 @@ use rayon::prelude::*;
 use unamalla_mesh::DVec2;
 
 use crate::auto::{needs_cut_point, triangle_plan, Builder};
-use crate::concavity::{concavity, critical_angles};
-use crate::corners::{quad_fit, select_corners};
+use crate::concavity::{concavity, concavity_with_angles, critical_angles};
+use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
+use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
+use crate::geom::ring_angles;
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
@@ -391,27 +393,132 @@ impl Host {
     }
 }
 
+/// A screen of the children of the candidate cuts of one ring ([`Builder::for_each_split`]),
+/// from the ring's vertex angles: a child cannot be good ([`Builder::good_fit`]) if it has
+/// fewer than four vertices, or if a vertex whose two neighbours it keeps (so that its
+/// `ring_angle` is the same computation on the same points as in the ring, bit for bit) has
+/// a critical angle (below θ₋: a critical angle of the child) or one above θ₊ (the child's
+/// largest angle exceeds θ₊: not approximately convex). Such vertices are *bad*.
+struct ChildScreen {
+    /// The ring's vertex count.
+    n: usize,
+    /// `prefix[k]`: bad vertices among `k mod n` for indices `0..k` of the ring read twice.
+    prefix: Vec<u32>,
+    /// The number of bad vertices.
+    bad: u32,
+}
+
+impl ChildScreen {
+    /// The screen of `ring`'s children: its bad vertices (by `ring_angle`) under the
+    /// tolerances of `opts`.
+    fn new(ring: &Ring, opts: &crate::DecomposeOptions) -> Self {
+        let tol = &opts.tolerances;
+        let n = ring.len();
+        let is_bad: Vec<bool> = ring_angles(&ring.pts)
+            .into_iter()
+            .map(|a| a < tol.theta_minus || a > tol.theta_plus)
+            .collect();
+        let mut prefix = Vec::with_capacity(2 * n + 1);
+        prefix.push(0);
+        for k in 0..2 * n {
+            prefix.push(prefix[k] + is_bad[k % n] as u32);
+        }
+        let bad = prefix[n];
+        Self { n, prefix, bad }
+    }
+
+    /// Bad vertices among the `len` ring vertices from `start` on (cyclically, `len` ≤ n).
+    fn bad_in(&self, start: usize, len: usize) -> u32 {
+        let s = start % self.n;
+        self.prefix[s + len] - self.prefix[s]
+    }
+
+    /// How many of the two children of the cut from vertex `e1` to `e2` (a vertex or a
+    /// point inside an edge, as [`Builder::for_each_split`] makes them) may be good.
+    ///
+    /// The cut from vertex `i` to vertex `j` gives the children `i … j` and `j … i`; the
+    /// vertices strictly between keep both neighbours. To the point `x` inside edge `e`
+    /// (`e`, `e + 1` not next to `i`) it gives `i … e, x` and `x, e + 1 … i`, in which `e`
+    /// and `e + 1` get `x` as a neighbour, so only `i + 1 … e − 1` and `e + 2 … i − 1` keep
+    /// theirs. The angles at the cut ends and at `e`, `e + 1` are not screened.
+    fn possibly_good(&self, e1: End, e2: End) -> usize {
+        let n = self.n;
+        let Pos::Vertex(i) = e1.pos else {
+            return 2;
+        };
+        // (vertex count, first kept vertex, kept vertex count) of each child
+        let children = match e2.pos {
+            Pos::Vertex(j) => {
+                let (ij, ji) = ((j + n - i) % n, (i + n - j) % n);
+                [(ij + 1, i + 1, ij - 1), (ji + 1, j + 1, ji - 1)]
+            }
+            Pos::OnEdge(e, _) => {
+                let (ie, ei) = ((e + n - i) % n, (i + 2 * n - e - 2) % n);
+                [(ie + 2, i + 1, ie - 1), (ei + 3, e + 2, ei)]
+            }
+        };
+        children
+            .iter()
+            .filter(|&&(count, start, len)| count >= 4 && self.bad_in(start, len) == 0)
+            .count()
+    }
+}
+
 impl Builder<'_> {
     /// Four usable corners (see the module documentation).
     pub(crate) fn usable(&self, ring: &[DVec2]) -> bool {
-        ring.len() >= 4 && select_corners(ring, &self.opts.corner_weights).is_some()
+        ring.len() >= 4 && self.usable_with_angles(ring, &ring_angles(ring))
+    }
+
+    /// [`Builder::usable`] with the ring's vertex angles given (`angles[i]` =
+    /// `ring_angle(ring, i)`). For the scoring selection only the existence of a corner tuple
+    /// matters, which [`has_four_corners`] decides from the angles alone (the same answer as
+    /// the exhaustive search, without it).
+    fn usable_with_angles(&self, ring: &[DVec2], angles: &[f64]) -> bool {
+        let w = &self.opts.corner_weights;
+        ring.len() >= 4
+            && if w.choice == CornerChoice::Scoring {
+                has_four_corners(angles, w)
+            } else {
+                select_corners(ring, w).is_some()
+            }
     }
 
     /// A block that needs no repair and may be produced by one: four usable corners,
     /// approximately convex, no critical angle, not negligible.
+    #[cfg(test)]
     fn good(&self, ring: &Ring) -> bool {
-        let tol = &self.opts.tolerances;
-        // cheapest tests first: the corner search is O(n⁴) in the ring's vertex count
         crate::geom::signed_area(&ring.pts) >= 0.1 * self.min_area
-            && critical_angles(&ring.pts, tol.theta_minus).is_empty()
-            && concavity(&ring.pts).approximately_convex(tol)
-            && self.usable(&ring.pts)
+            && self.good_with_angles(ring, &ring_angles(&ring.pts))
+    }
+
+    /// [`Builder::good`] apart from the area test, with the ring's vertex angles given
+    /// (`angles[i]` = `ring_angle(ring, i)`). The tests are pure, so their order does not
+    /// change the answer; the cheap ones from the angles come first and the convex hull of
+    /// the concavity measures last. The spike criterion (largest angle ≤ θ₊) is the first
+    /// test of [`Concavity::approximately_convex`](crate::Concavity::approximately_convex),
+    /// on the same largest angle (the fold of the same values), so testing it early changes
+    /// nothing.
+    fn good_with_angles(&self, ring: &Ring, angles: &[f64]) -> bool {
+        let tol = &self.opts.tolerances;
+        !angles.iter().any(|&a| a < tol.theta_minus)
+            && (ring.len() < 3 || angles.iter().copied().fold(0.0, f64::max) <= tol.theta_plus)
+            && self.usable_with_angles(&ring.pts, angles)
+            && concavity_with_angles(&ring.pts, angles).approximately_convex(tol)
     }
 
     /// The corner score F of a good block ([`Builder::good`]); `None` if it is not good. The
-    /// acceptance of steps 1–3.
+    /// acceptance of steps 1–3. The vertex angles are computed once for all the tests and the
+    /// score.
     fn good_fit(&self, ring: &Ring) -> Option<f64> {
-        self.good(ring).then(|| quad_fit(&ring.pts))
+        // the area test of `good`, as written there (a NaN area fails it)
+        let big_enough = crate::geom::signed_area(&ring.pts) >= 0.1 * self.min_area;
+        if !big_enough {
+            return None;
+        }
+        let angles = ring_angles(&ring.pts);
+        self.good_with_angles(ring, &angles)
+            .then(|| quad_fit_with_angles(&ring.pts, &angles))
     }
 
     /// `true` if block `ring` should be repaired: four or more vertices and fewer than four
@@ -437,7 +544,7 @@ impl Builder<'_> {
 
     /// The best cut splitting `ring` into two good blocks.
     fn best_split(&self, ring: &Ring) -> Option<Split> {
-        self.best_split_by(ring, &|r: &Ring| self.good_fit(r))
+        self.best_split_by(ring, &|r: &Ring| self.good_fit(r), true)
     }
 
     /// The best cut splitting `ring` into two blocks that `accept` takes; `accept` returns the
@@ -447,17 +554,23 @@ impl Builder<'_> {
     /// The quarter points of the original-boundary edges are offered only when the vertices
     /// and feet give no acceptable split (so they add repairs without changing the ones that
     /// worked before), and only with [`DecomposeOptions::edge_point_cuts`](crate::DecomposeOptions::edge_point_cuts).
+    ///
+    /// `good_only` says that `accept` takes only good blocks ([`Builder::good_fit`], possibly
+    /// narrowed): then candidates whose children cannot both be good are not built
+    /// ([`Builder::for_each_split`]); it changes no result.
     fn best_split_by(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
+        good_only: bool,
     ) -> Option<Split> {
-        self.best_split_with(ring, accept, false).or_else(|| {
-            self.opts
-                .edge_point_cuts
-                .then(|| self.best_split_with(ring, accept, true))
-                .flatten()
-        })
+        self.best_split_with(ring, accept, good_only, false)
+            .or_else(|| {
+                self.opts
+                    .edge_point_cuts
+                    .then(|| self.best_split_with(ring, accept, good_only, true))
+                    .flatten()
+            })
     }
 
     /// [`Builder::best_split_by`] with or without the quarter-point targets.
@@ -465,10 +578,12 @@ impl Builder<'_> {
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
+        good_only: bool,
         quarter_points: bool,
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
-        self.for_each_split(ring, quarter_points, &mut |pre, a, b, ends| {
+        let need = if good_only { 2 } else { 0 };
+        self.for_each_split(ring, quarter_points, need, &mut |pre, a, b, ends| {
             let (Some(fa), Some(fb)) = (accept(&a), accept(&b)) else {
                 return;
             };
@@ -485,24 +600,39 @@ impl Builder<'_> {
     /// the children (the new cut tagged [`TMP_CUT`]) and `ends` the cut's endpoints. Targets:
     /// vertex → vertex and vertex → foot of the perpendicular on an original-boundary edge,
     /// with `quarter_points` also the quarter points of those edges.
+    ///
+    /// With `need` = 1 or 2, the caller will only use a candidate of which at least `need`
+    /// children are good ([`Builder::good_fit`]): a counted candidate (it still counts towards
+    /// the 80) whose children cannot be is not built or visited ([`ChildScreen`]), and when no
+    /// candidate can pass, nothing is searched. `need` = 0 visits every counted candidate.
     fn for_each_split(
         &self,
         ring: &Ring,
         quarter_points: bool,
+        need: usize,
         visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
     ) {
-        let piece = Piece {
-            outer: ring.clone(),
-            holes: Vec::new(),
-        };
         let n = ring.len();
         if n < 4 {
             return;
         }
+        let screen = (need > 0).then(|| ChildScreen::new(ring, self.opts));
+        if screen.as_ref().is_some_and(|c| need == 2 && c.bad > 3) {
+            // a cut changes the angles of at most three vertices of `ring` (its start vertex,
+            // and its end vertex or the two ends of the edge it ends on): some bad vertex
+            // keeps its angle in a child, which is then not good
+            return;
+        }
+        let piece = Piece {
+            outer: ring.clone(),
+            holes: Vec::new(),
+        };
         let idx = piece.index();
         let sq = piece.area().abs().sqrt().max(1e-300);
         let w = self.opts.cut_weights;
         let mut cands: Vec<(f64, End, End)> = Vec::new();
+        // the target list, reused for every start vertex
+        let mut t = Vec::new();
         for i in 0..n {
             let p = ring.p(i);
             let e1 = End {
@@ -510,7 +640,7 @@ impl Builder<'_> {
                 pos: Pos::Vertex(i),
             };
             let near = |j: usize| j == i || j == (i + 1) % n || j == (i + n - 1) % n;
-            let mut t = Vec::new();
+            t.clear();
             Self::targets_on_ring(&piece, 0, p, &near, &mut t);
             // also the quarter points of the original-boundary edges: a cut that met the
             // boundary at a critical angle at a vertex can end inside the edge instead, where
@@ -528,7 +658,7 @@ impl Builder<'_> {
                     });
                 }
             }
-            for e2 in t {
+            for &e2 in &t {
                 if let Pos::Vertex(j) = e2.pos {
                     if j < i {
                         continue; // each vertex pair once
@@ -541,8 +671,12 @@ impl Builder<'_> {
                 cands.push((w.angle * pen + w.length * p.distance(q) / sq, e1, e2));
             }
         }
-        cands.sort_by(|a, b| {
-            a.0.total_cmp(&b.0).then_with(|| {
+        // a stable sort of (pre, position) pairs by the candidates' order: the same sequence
+        // as a stable sort of the candidates themselves, with less to move
+        let mut order: Vec<(f64, usize)> = (0..cands.len()).map(|k| (cands[k].0, k)).collect();
+        order.sort_by(|&(sa, ka), &(sb, kb)| {
+            sa.total_cmp(&sb).then_with(|| {
+                let (a, b) = (&cands[ka], &cands[kb]);
                 let (pa, pb) = (piece.point(a.1), piece.point(b.1));
                 let (qa, qb) = (piece.point(a.2), piece.point(b.2));
                 pa.x.total_cmp(&pb.x)
@@ -552,7 +686,7 @@ impl Builder<'_> {
             })
         });
         let mut evaluated = 0;
-        for (pre, e1, e2) in cands {
+        for (pre, e1, e2) in order.into_iter().map(|(_, k)| cands[k]) {
             if evaluated >= 80 {
                 break;
             }
@@ -560,6 +694,12 @@ impl Builder<'_> {
                 continue;
             }
             evaluated += 1;
+            if screen
+                .as_ref()
+                .is_some_and(|c| c.possibly_good(e1, e2) < need)
+            {
+                continue;
+            }
             let mut m = piece.clone();
             let (x, y) = m.insert_ends(e1, e2);
             let (a, b) = m.split(x, y, TMP_CUT);
@@ -573,10 +713,12 @@ impl Builder<'_> {
     /// not already give two accepted children are followed (those are steps 1–2). Score
     /// `½·max(F₁, F₂, F₃) + (F₁ + F₂ + F₃)/6 + pre₁ + pre₂` — the two-child score
     /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
+    /// `good_only` as in [`Builder::best_split_by`].
     fn best_split3(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
+        good_only: bool,
     ) -> Option<Resplit> {
         let mut best: Option<Resplit> = None;
         for quarter_points in [false, true] {
@@ -586,7 +728,9 @@ impl Builder<'_> {
             // the first cuts in their order, then the second-cut searches in parallel, the
             // results compared in that same order (as a sequential loop would)
             let mut firsts = Vec::new();
-            self.for_each_split(ring, quarter_points, &mut |pre1, a, b, ends1| {
+            // a first cut is followed only if it leaves exactly one accepted child
+            let need = if good_only { 1 } else { 0 };
+            self.for_each_split(ring, quarter_points, need, &mut |pre1, a, b, ends1| {
                 firsts.push((pre1, a, b, ends1));
             });
             let found: Vec<Option<Resplit>> = firsts
@@ -598,7 +742,8 @@ impl Builder<'_> {
                         (None, Some(fb)) => (b, fb, a),
                         _ => return None,
                     };
-                    let (s2, r1, r2, ends2) = self.best_split_by(&as_first_cut(rest), accept)?;
+                    let (s2, r1, r2, ends2) =
+                        self.best_split_by(&as_first_cut(rest), accept, good_only)?;
                     let (f1, f2) = (accept(&r1)?, accept(&r2)?);
                     let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
                     let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
@@ -677,19 +822,23 @@ impl Builder<'_> {
     /// (the two blocks share exactly that cut's endpoints): the union alone if `accept` takes
     /// it, else the best split of the union by `accept`. Returns (score, neighbour slot, cut,
     /// split or `None` for the union alone, union).
+    /// `good_only` as in [`Builder::best_split_by`].
     fn best_merge(
         &self,
         slot: &[Option<Ring>],
         k: usize,
         alive: &[bool],
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
+        good_only: bool,
     ) -> Option<Merge> {
         let mut best: Option<Merge> = None;
         let r = slot[k].as_ref()?;
         for (j, c, u) in self.neighbour_unions(slot, r, &[k], alive) {
             let option = match accept(&u) {
                 Some(cost) => Some((cost, None)),
-                None => self.best_split_by(&u, accept).map(|s| (s.0, Some(s))),
+                None => self
+                    .best_split_by(&u, accept, good_only)
+                    .map(|s| (s.0, Some(s))),
             };
             if let Some((s, split)) = option {
                 if beats(
@@ -806,10 +955,10 @@ impl Builder<'_> {
             }
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
             let two = matches!(host, Host::Merged2 { .. })
-                .then(|| self.best_split_by(&u, &good))
+                .then(|| self.best_split_by(&u, &good, true))
                 .flatten()
                 .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
-            for s in two.into_iter().chain(self.best_split3(&u, &good)) {
+            for s in two.into_iter().chain(self.best_split3(&u, &good, true)) {
                 if beats(
                     s.0,
                     ring_key(&s.1[0]),
@@ -943,8 +1092,8 @@ impl Builder<'_> {
             }
             budget -= 1;
             let relaxed = |u: &Ring| self.relaxed_cost(u);
-            let alone = self.best_split_by(&r, &relaxed);
-            let merge = self.best_merge(slot, k, alive, &relaxed);
+            let alone = self.best_split_by(&r, &relaxed, false);
+            let merge = self.best_merge(slot, k, alive, &relaxed, false);
             match (alone, merge) {
                 (Some(s), m) if m.as_ref().is_none_or(|m| s.0 <= m.0) => {
                     let (_, a, b, ends) = s;
@@ -967,7 +1116,7 @@ impl Builder<'_> {
         if let Some(s) = self.best_split(r) {
             return Attempt::Split(s);
         }
-        if let Some(m) = self.best_merge(slot, k, alive, &|u: &Ring| self.good_fit(u)) {
+        if let Some(m) = self.best_merge(slot, k, alive, &|u: &Ring| self.good_fit(u), true) {
             return Attempt::Merge(m);
         }
         match self.best_resplit(slot, k, alive) {
