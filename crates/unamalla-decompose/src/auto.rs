@@ -330,15 +330,7 @@ pub(crate) struct LayoutCache {
 fn piece_key(piece: &Piece) -> Vec<u64> {
     let mut key = Vec::new();
     for r in piece.rings() {
-        key.push(r.len() as u64);
-        for (p, t) in r.pts.iter().zip(&r.tags) {
-            key.push(p.x.to_bits());
-            key.push(p.y.to_bits());
-            match *t {
-                Tag::Boundary(b) => key.extend([0, b as u64]),
-                Tag::Cut(c) => key.extend([1, c as u64]),
-            }
-        }
+        r.push_key(&mut key, |c, key| key.extend([1, c as u64]));
     }
     key
 }
@@ -525,14 +517,7 @@ impl<'a> Builder<'a> {
             region,
             opts,
             cuts: Vec::new(),
-            nodes: vec![TreeNode {
-                label: String::new(),
-                parent: None,
-                children: Vec::new(),
-                step: None,
-                cuts: Vec::new(),
-                block: None,
-            }],
+            nodes: vec![TreeNode::root()],
             pieces: vec![Some(Piece { outer, holes })],
             protected_cuts: 0,
             min_area: opts.min_area_fraction * region.area(),
@@ -723,14 +708,7 @@ impl<'a> Builder<'a> {
             region: self.region,
             opts: self.opts,
             cuts: self.cuts.clone(),
-            nodes: vec![TreeNode {
-                label: String::new(),
-                parent: None,
-                children: Vec::new(),
-                step: None,
-                cuts: Vec::new(),
-                block: None,
-            }],
+            nodes: vec![TreeNode::root()],
             pieces: vec![Some(piece.clone())],
             protected_cuts: self.protected_cuts,
             min_area: self.min_area,

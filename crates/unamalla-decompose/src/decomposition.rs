@@ -97,6 +97,20 @@ pub struct TreeNode {
     pub block: Option<usize>,
 }
 
+impl TreeNode {
+    /// The root of a decomposition tree: the whole region, no parent, no step, no cuts yet.
+    pub(crate) fn root() -> Self {
+        TreeNode {
+            label: String::new(),
+            parent: None,
+            children: Vec::new(),
+            step: None,
+            cuts: Vec::new(),
+            block: None,
+        }
+    }
+}
+
 /// A maximal piece Q_j of a block side: one whole cut, or a run of original boundary between
 /// corners / cut endpoints (seed 000 digest §4.1).
 #[derive(Debug, Clone, PartialEq)]

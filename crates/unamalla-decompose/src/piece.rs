@@ -24,6 +24,21 @@ pub(crate) struct Ring {
 }
 
 impl Ring {
+    /// Appends the exact content of this ring to a cache key: its length, then per vertex the
+    /// coordinate bits and the leaving edge's tag — `0, b` for region boundary `b`, and
+    /// whatever `cut` writes for a cut (the caches differ in how they name cuts).
+    pub(crate) fn push_key(&self, key: &mut Vec<u64>, mut cut: impl FnMut(usize, &mut Vec<u64>)) {
+        key.push(self.len() as u64);
+        for (p, t) in self.pts.iter().zip(&self.tags) {
+            key.push(p.x.to_bits());
+            key.push(p.y.to_bits());
+            match *t {
+                Tag::Boundary(b) => key.extend([0, b as u64]),
+                Tag::Cut(c) => cut(c, key),
+            }
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.pts.len()
     }

@@ -298,25 +298,17 @@ impl Neighbourhood {
                 key.push(u64::MAX);
                 continue;
             };
-            key.push(r.len() as u64);
-            for (p, t) in r.pts.iter().zip(&r.tags) {
-                key.push(p.x.to_bits());
-                key.push(p.y.to_bits());
-                match *t {
-                    Tag::Boundary(b) => key.extend([0, b as u64]),
-                    Tag::Cut(c) => {
-                        let canon = match cuts.iter().position(|&x| x == c) {
-                            Some(i) => i,
-                            None => {
-                                cuts.push(c);
-                                cuts.len() - 1
-                            }
-                        };
-                        let live = alive.get(c).copied().unwrap_or(false);
-                        key.extend([1, canon as u64, (c < protected) as u64, live as u64]);
+            r.push_key(&mut key, |c, key| {
+                let canon = match cuts.iter().position(|&x| x == c) {
+                    Some(i) => i,
+                    None => {
+                        cuts.push(c);
+                        cuts.len() - 1
                     }
-                }
-            }
+                };
+                let live = alive.get(c).copied().unwrap_or(false);
+                key.extend([1, canon as u64, (c < protected) as u64, live as u64]);
+            });
         }
         Self { slots, cuts, key }
     }
