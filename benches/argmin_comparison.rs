@@ -21,6 +21,8 @@
 //! restricted with `UNAMALLA_BENCH_SIZES`, e.g. `UNAMALLA_BENCH_SIZES=100` (default `100,300`).
 //!
 //! `cargo bench -p unamalla-workspace --bench argmin_comparison [-- FILTER]`
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use std::sync::Arc;
 

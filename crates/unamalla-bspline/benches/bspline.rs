@@ -4,6 +4,8 @@
 //! ```sh
 //! cargo bench -p unamalla-bspline --bench bspline
 //! ```
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use unamalla_bspline::synthetic::Synthetic;

@@ -37,7 +37,6 @@
 //! # Ok::<(), unamalla_bspline::BsplineError>(())
 //! ```
 
-#![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 // Index loops mirror the subscripts of the formulas (i, j, r, s, k, l as in the docs).
 #![allow(clippy::needless_range_loop)]

@@ -16,7 +16,7 @@ use unamalla_core::mesh::{HasNodes, QuadMesh, Region};
 use unamalla_core::optim::{self, NullObserver, Observer, ProgressObserver, SmoothOptions};
 use unamalla_core::output::{OutputDir, OutputFiles};
 use unamalla_core::pipeline::{Mesher, Strategy};
-use unamalla_core::render;
+use unamalla_core::OutputOptions;
 
 /// Input and export options of `unamalla mesh` (issue #26): region formats, feature
 /// selection, coordinate system, solver formats and the HTML report.
@@ -101,11 +101,6 @@ fn load_region(path: &Path, gis: &SolverGisArgs, quiet: bool) -> Result<io::Load
 
 fn write_text(path: &Path, text: &str) -> Result<()> {
     io::atomic_write(path, |w| w.write_all(text.as_bytes()))
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    io::atomic_write(path, |w| w.write_all(bytes))
         .with_context(|| format!("writing {}", path.display()))
 }
 
@@ -426,81 +421,32 @@ fn mesh_part(
     }
 
     // everything computed: now write (into the staging directory)
-    let mesh = &result.mesh;
-    let json = serde_json::to_string_pretty(&report)?;
-    writing(&a.output, || {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let arrays = quad_cell_metrics(mesh.global());
-        let global: Vec<(&str, &[f64])> = arrays.iter().map(|(k, v)| (*k, v.as_slice())).collect();
-        let block_arrays: Vec<Vec<(&'static str, Vec<f64>)>> =
-            mesh.blocks().iter().map(quad_cell_metrics).collect();
-        let block_refs: Vec<Vec<(&str, &[f64])>> = block_arrays
-            .iter()
-            .map(|b| b.iter().map(|(k, v)| (*k, v.as_slice())).collect())
-            .collect();
-        let block_slices: Vec<&[(&str, &[f64])]> =
-            block_refs.iter().map(|v| v.as_slice()).collect();
-        io::write_block_mesh(dir, mesh, &block_slices, &global)?;
-        let groups = if loaded.names.is_empty() {
-            io::msh::boundary_edge_groups(mesh.global())
+    let mut result = result;
+    result.report = report;
+    let report = &result.report;
+    let json = unamalla_core::write::report_json(report)?;
+    let groups = if loaded.names.is_empty() {
+        io::msh::boundary_edge_groups(result.mesh.global())
+    } else {
+        io::named_edge_groups(result.mesh.global(), &region, &loaded.names)?
+    };
+    // the extrusion's default thickness: the mean cell size of the input region
+    let cell_size = (region.area() / report.cells.max(1) as f64).sqrt();
+    let opts = OutputOptions::default()
+        .formats(exports.msh, exports.su2, exports.openfoam, exports.cgns)
+        .thickness(Some(a.gis.thickness.unwrap_or(cell_size)))
+        .patches(&region, &loaded.names)
+        .lonlat(if a.gis.lonlat {
+            loaded.projection.as_ref()
         } else {
-            io::named_edge_groups(mesh.global(), &region, &loaded.names)?
-        };
-        if exports.msh {
-            io::write_msh_blocks(dir.join("mesh.msh"), mesh, "domain", &groups)?;
-        }
-        if exports.su2 {
-            io::write_su2(dir.join("mesh.su2"), mesh.global(), &groups)?;
-        }
-        let cell_size = (region.area() / report.cells.max(1) as f64).sqrt();
-        if exports.openfoam {
-            let t = a.gis.thickness.unwrap_or(cell_size);
-            io::write_openfoam(dir.join("openfoam"), mesh.global(), &groups, t)?;
-        }
-        #[cfg(feature = "cgns")]
-        if exports.cgns {
-            unamalla_io::cgns::write_cgns(dir.join("mesh.cgns"), mesh, &groups)?;
-        }
-        if let (true, Some(p)) = (a.gis.lonlat, &loaded.projection) {
-            let g = mesh.global();
-            let ll = g
-                .nodes()
-                .iter()
-                .map(|&q| p.inverse(q))
-                .collect::<Result<Vec<_>, _>>()?;
-            let back = QuadMesh::new(ll, g.cells().to_vec())?;
-            io::write_msh_quads(dir.join("mesh-lonlat.msh"), &back, "domain", &groups)?;
-        }
-        write_text(
-            &dir.join("decomposition.json"),
-            &result.decomposition.to_json(),
-        )?;
-        write_text(
-            &dir.join("decomposition.svg"),
-            &result.decomposition.to_svg(&result.simplified),
-        )?;
-        write_text(
-            &dir.join("mesh.svg"),
-            &render::quality_svg(mesh.global(), Some(&result.simplified), 1200.0),
-        )?;
-        write_bytes(
-            &dir.join("mesh.png"),
-            &render::quality_png(mesh.global(), Some(&result.simplified), 1600)?,
-        )?;
-        write_text(&dir.join("report.json"), &json)?;
-        if a.rectilinear {
-            let value = match unamalla_core::mesh::rectilinear::develop(mesh) {
-                Ok(r) => serde_json::to_value(&r)?,
-                Err(e) => serde_json::json!({ "error": e.to_string() }),
-            };
-            write_text(
-                &dir.join("rectilinear.json"),
-                &serde_json::to_string(&value)?,
-            )?;
-        }
+            None
+        })
+        .rectilinear(a.rectilinear);
+    writing(&a.output, || {
+        result.write_files(dir, &opts)?;
         if !a.gis.no_report {
             let settings = crate::report::Settings::of_run(a, loaded, &groups);
-            let html = crate::report::report_html(&result, &report, &settings);
+            let html = crate::report::report_html(&result, report, &settings);
             write_text(&dir.join("report.html"), &html)?;
         }
         Ok(())
@@ -522,7 +468,7 @@ fn mesh_part(
             a.output.display()
         );
     }
-    Ok((serde_json::to_value(&report)?, not_met))
+    Ok((serde_json::to_value(report)?, not_met))
 }
 
 /// Reads a mesh file of any format `unamalla mesh` writes: VTK legacy (`.vtk`), VTK XML

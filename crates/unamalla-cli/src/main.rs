@@ -29,7 +29,7 @@
 //! failed run leaves the target as it was. Before success is reported the output is checked
 //! independently ([`unamalla_core::verify`]).
 
-// Issue #14: no `unwrap`/`expect` on paths user input can reach (tests may use them).
+// No `unwrap`/`expect` on paths user input can reach (tests may use them; docs/reliability.md).
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 use std::path::PathBuf;

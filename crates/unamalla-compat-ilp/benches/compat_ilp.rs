@@ -3,6 +3,8 @@
 //! network-flow path, and — with `--features cbc` — the Cbc backend.
 //!
 //! Run: `cargo bench -p unamalla-compat-ilp --bench compat_ilp`
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use unamalla_compat_ilp::fixtures::grid_decomposition;

@@ -94,8 +94,7 @@
 //! Curves are referenced by 0-based **index** into [`CompatProblem::curves`]; each curve has a user-facing
 //! `id` used in messages and printed equations (`m{id}`). [`CompatProblem::from_index_sets`] builds the
 //! thesis numbering `J_{k,side}` (erratum 13: that convention is authoritative).
-#![warn(missing_docs)]
-// No unwrap/expect in library code: user input must give an error, never a panic (issue #14,
+// No unwrap/expect in library code: user input must give an error, never a panic (see
 // docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 

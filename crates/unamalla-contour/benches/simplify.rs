@@ -7,6 +7,8 @@
 //! ```text
 //! RAYON_NUM_THREADS=1 cargo bench -p unamalla-contour --bench simplify
 //! ```
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use unamalla_contour::{simplify_region, Method, Preset, SimplifyOptions};

@@ -75,8 +75,7 @@
 //! the sampled value), for the methods that move points the sampled [`hausdorff`]. Holes can be
 //! dropped below an area threshold first ([`HoleFilter`]).
 
-#![warn(missing_docs)]
-// No unwrap/expect in library code: user input must give an error, never a panic (issue #14,
+// No unwrap/expect in library code: user input must give an error, never a panic (see
 // docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 

@@ -12,6 +12,8 @@
 //! CARGO_TARGET_DIR=... cargo bench -p unamalla-core --bench hex
 //! RAYON_NUM_THREADS=1 cargo bench -p unamalla-core --bench hex -- hessian   # one core
 //! ```
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use std::sync::Arc;
 use std::time::Duration;

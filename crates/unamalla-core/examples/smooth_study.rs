@@ -33,8 +33,7 @@
 //! All candidates but `default` and `c2f*` run without coarse levels. The progress line of the
 //! coarse levels (cells and iterations per level) is printed under the table row.
 
-use std::cell::RefCell;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use unamalla_core::io::{read_region_geojson, PartSelector};
@@ -147,7 +146,7 @@ fn main() {
             };
             let cpu0 = cpu_seconds();
             let t0 = Instant::now();
-            let coarse_line = Rc::new(RefCell::new(String::new()));
+            let coarse_line = Arc::new(Mutex::new(String::new()));
             let line = coarse_line.clone();
             let r = Mesher::new()
                 .cells(cells)
@@ -155,7 +154,7 @@ fn main() {
                 .coarse_levels(levels)
                 .on_progress(move |stage, msg| {
                     if stage == Stage::Smooth && msg.starts_with("coarse levels") {
-                        *line.borrow_mut() = msg.to_string();
+                        *line.lock().unwrap_or_else(|e| e.into_inner()) = msg.to_string();
                     }
                 })
                 .mesh_observed(&region, &mut count);
@@ -184,7 +183,7 @@ fn main() {
                 }
                 Err(e) => println!("| {name} | {cand} | error: {e} |"),
             }
-            let line = coarse_line.borrow();
+            let line = coarse_line.lock().unwrap_or_else(|e| e.into_inner());
             if !line.is_empty() {
                 eprintln!("  {name} {cand}: {line}");
             }

@@ -11,6 +11,32 @@ use unamalla_mesh::Polygon;
 
 use crate::CoreError;
 
+/// Why four block corners could not be chosen, or the given ones are not valid.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CornersError {
+    /// No four vertices pass the admissibility filter (convex, not flat, balanced sides).
+    #[error("no four admissible corners (convex, not flat, balanced sides) among the {vertices} vertices")]
+    NoAdmissibleQuadruple {
+        /// Vertices of the polygon.
+        vertices: usize,
+    },
+    /// A given corner index is not a vertex of the outer ring.
+    #[error("corner index {index} is not a vertex of the outer ring as given (the ring has {vertices} vertices after cleaning)")]
+    NotAVertex {
+        /// The index given.
+        index: usize,
+        /// Vertices of the ring after cleaning.
+        vertices: usize,
+    },
+    /// The given corners are not four distinct vertices.
+    #[error("corners {corners:?} are not four distinct vertices")]
+    NotDistinct {
+        /// The indices given.
+        corners: [usize; 4],
+    },
+}
+
 /// Chooses four corners of `poly` (indices into its points, counter-clockwise order). When
 /// `aspect` (the wanted ratio bottom-side length / left-side length, e.g. `(M−1)/(N−1)` for an
 /// `M × N` grid) is given, the quadruple is rotated so that the bottom/top pair best matches it.
@@ -18,11 +44,9 @@ use crate::CoreError;
 /// Errors: no admissible quadruple (e.g. fewer than four convex, non-flat vertices).
 pub fn auto_corners(poly: &Polygon, aspect: Option<f64>) -> Result<[usize; 4], CoreError> {
     let n = poly.len();
-    let (mut q, _) = select_corners(poly.points(), &CornerWeights::default()).ok_or_else(|| {
-        CoreError::Corners(format!(
-            "no four admissible corners (convex, not flat, balanced sides) among the {n} vertices"
-        ))
-    })?;
+    let (mut q, _) = select_corners(poly.points(), &CornerWeights::default()).ok_or(
+        CoreError::Corners(CornersError::NoAdmissibleQuadruple { vertices: n }),
+    )?;
     if let Some(aspect) = aspect.filter(|a| a.is_finite() && *a > 0.0) {
         let pts = poly.points();
         let arc = |a: usize, b: usize| {

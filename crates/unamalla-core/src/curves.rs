@@ -506,9 +506,7 @@ pub fn compatible_counts(d: &Decomposition, size: MeshSize) -> Result<Compatible
         h = next;
     }
     let Some((h, targets, solution, predicted_cells)) = best else {
-        return Err(CoreError::Unsupported(
-            "no cell budget iteration ran".into(),
-        ));
+        return Err(CoreError::NoCellBudget);
     };
     let mut notes = Vec::new();
     if (predicted_cells as f64 / want - 1.0).abs() > BUDGET_REPORT_TOLERANCE {

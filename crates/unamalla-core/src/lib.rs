@@ -1,17 +1,46 @@
 //! # unamalla-core
 //!
-//! The crate simulation codes add (`cargo add unamalla-core`). It re-exports the stage crates
-//! and offers the high-level operations:
+//! The crate users add (`cargo add unamalla-core`): a region with holes in, a
+//! block-structured, singularity-free, all-convex quadrilateral mesh out.
+//!
+//! ```no_run
+//! use unamalla_core::prelude::*;
+//!
+//! let region = unamalla_core::io::read_region_geojson(
+//!     "fixtures/regions/puget-sound.geojson", Default::default())?;
+//! let result = Mesher::new().cells(20_000).mesh(&region)?;
+//! assert_eq!(result.report.non_convex_cells, 0); // checked by the mesher itself
+//! assert_eq!(result.report.interior_singularities, 0);
+//! // mesh.vtu, block-K.vts, mesh.msh, mesh.su2, openfoam/, report.json, pictures
+//! result.write_all("out/puget-sound", &OutputOptions::default())?;
+//! # Ok::<(), unamalla_core::CoreError>(())
+//! ```
+//!
+//! [`Mesher`] runs the whole job ([`pipeline`] explains each stage and its sources): contour
+//! simplification, decomposition into four-sided blocks by cuts (Tinoco-Ruiz's
+//! thesis method, or submapping), compatible point counts across the cuts (an integer
+//! program), transfinite interpolation per block, merging into one conformal mesh, and
+//! smoothing with the convexity-preserving functional
+//! `F = (1−σ)·F_AO + σ·H_ω` (area–orthogonality and the adaptive harmonic functional),
+//! then an independent check ([`verify`]) — a mesh with a non-convex cell is never returned
+//! as a success. [`MeshResult::write_all`] writes the file set of `unamalla mesh`
+//! ([`write`](mod@write)); [`MeshReport`] is its `report.json`.
+//!
+//! Other operations:
 //!
 //! * [`single_block`]: one structured grid on a roughly four-sided region by transfinite
-//!   interpolation (seed 000 digest §5.1) between four arc-length-resampled sides (§4.5), with
-//!   automatic corners ([`corners`], §4.2) or corners given by the user;
+//!   interpolation between four arc-length-resampled sides, with automatic corners
+//!   ([`corners`]) or corners given by the user;
 //! * [`bspline_maps`]: bilinear and (where certified) biquadratic B-spline maps of every block
-//!   of a block mesh (seed 003, crate [`bspline`]);
+//!   of a block mesh (crate [`bspline`]);
 //! * [`pde`]: the elliptic PDE solver on convex structured grids and singularity-free quad
-//!   meshes (seed 001 RF12: 9-point transformed stencil, SOR with automatic ω, sparse LU with
-//!   the `direct` feature), with manufactured solutions for verification;
+//!   meshes (9-point transformed stencil, SOR with automatic ω, sparse LU with the `direct`
+//!   feature), with manufactured solutions for verification;
 //! * quality reports ([`mesh::quality::QualityReport`]) and file formats ([`io`]).
+//!
+//! The stage crates are re-exported ([`mesh`], [`io`], [`contour`], [`decompose`],
+//! [`compat_ilp`], [`functionals`], [`optim`], [`bspline`]) together with [`glam`], whose
+//! `DVec2`/`DVec3` are the points of the whole API.
 //!
 //! ```
 //! use unamalla_core::{mesh::{DVec2, Region, quality::QualityReport}, single_block};
@@ -28,7 +57,6 @@
 //! assert_eq!(report.non_convex_cells, 0);
 //! ```
 
-#![warn(missing_docs)]
 // user input reaches every stage: no unwrap/expect outside tests (issue #14)
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
@@ -47,6 +75,18 @@ pub mod render;
 pub mod single_block;
 pub mod untangle;
 pub mod verify;
+pub mod write;
+
+pub use pipeline::{MeshReport, MeshResult, MeshSize, Mesher, Stage, Strategy};
+pub use write::OutputOptions;
+
+/// The names the main job needs: `use unamalla_core::prelude::*;`.
+pub mod prelude {
+    pub use crate::mesh::{DVec2, Region};
+    pub use crate::pipeline::{MeshReport, MeshResult, MeshSize, Mesher, Stage, Strategy};
+    pub use crate::write::OutputOptions;
+    pub use crate::CoreError;
+}
 
 /// The `glam` release whose `DVec2`/`DVec3` are the points of the whole API (re-exported so users
 /// get the matching types without naming a version of their own).
@@ -67,6 +107,7 @@ pub use unamalla_mesh as mesh;
 
 /// Errors of the high-level operations.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum CoreError {
     /// Invalid region geometry.
     #[error(transparent)]
@@ -79,7 +120,7 @@ pub enum CoreError {
     Io(#[from] unamalla_io::IoError),
     /// Corners could not be chosen or the given ones are invalid.
     #[error("corners: {0}")]
-    Corners(String),
+    Corners(#[from] corners::CornersError),
     /// Contour simplification failed.
     #[error(transparent)]
     Contour(#[from] unamalla_contour::ContourError),
@@ -92,9 +133,36 @@ pub enum CoreError {
     /// Smoothing failed.
     #[error(transparent)]
     Optim(#[from] unamalla_optim::OptimError),
-    /// The operation does not apply to this region.
-    #[error("{0}")]
-    Unsupported(String),
+    /// A single TFI block was asked for a region with holes.
+    #[error("the region has {holes} hole(s); a single TFI block needs a simply connected four-sided region (use the block-structured mesher)")]
+    HolesInSingleBlock {
+        /// Holes of the region.
+        holes: usize,
+    },
+    /// A cell count of zero was asked for.
+    #[error("--cells 0: a mesh needs at least 1 cell")]
+    ZeroCells,
+    /// A decomposition file was given together with the submapping strategy.
+    #[error("a decomposition file and the submap strategy exclude each other")]
+    DecompositionWithSubmap,
+    /// No candidate layout could be built (and the concavity layout gave no error to report).
+    #[error("no block layout could be built")]
+    NoLayout,
+    /// The cell-budget search of the compatible counts made no iteration (an empty curve set).
+    #[error("no cell budget iteration ran")]
+    NoCellBudget,
+    /// CGNS output was asked for in a build without the `cgns` feature.
+    #[error("CGNS output needs a build with the `cgns` feature (system CGNS library)")]
+    CgnsNotBuilt,
+    /// A picture could not be made ([`render`]).
+    #[error(transparent)]
+    Render(#[from] render::RenderError),
+    /// Writing the output directory failed ([`output`]).
+    #[error(transparent)]
+    Output(#[from] output::OutputError),
+    /// Serializing a JSON output failed.
+    #[error("writing JSON: {0}")]
+    Json(#[from] serde_json::Error),
     /// A B-spline map could not be built or certified.
     #[error(transparent)]
     Bspline(#[from] unamalla_bspline::BsplineError),

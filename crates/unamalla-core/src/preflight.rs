@@ -724,20 +724,16 @@ mod tests {
         let (a, b, g) = ring_gaps(&r).unwrap();
         assert_eq!((a, b), (0, 1));
         assert!((g - 1e-9).abs() < 1e-15, "{g}");
-        let e = explain_failure(
-            CoreError::Unsupported("edge between global nodes 0 and 0".into()),
-            &r,
-            0.1,
-        );
+        let e = explain_failure(CoreError::NoLayout, &r, 0.1);
         let s = e.to_string();
         assert!(
             s.starts_with("hole 0 is 1.000e-9 from the outer ring"),
             "{s}"
         );
-        assert!(s.contains("edge between global nodes 0 and 0"), "{s}");
+        assert!(s.contains("no block layout could be built"), "{s}");
         // a wide gap leaves the error alone
         let r = Region::new(outer, vec![sq(1.0, 1.0, 2.0, 2.0)]).unwrap();
-        let e = explain_failure(CoreError::Unsupported("x".into()), &r, 0.1);
-        assert_eq!(e.to_string(), "x");
+        let e = explain_failure(CoreError::NoLayout, &r, 0.1);
+        assert_eq!(e.to_string(), "no block layout could be built");
     }
 }

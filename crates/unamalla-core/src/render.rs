@@ -9,7 +9,31 @@ use unamalla_mesh::quality::mu;
 use unamalla_mesh::svg::{Style, SvgCanvas};
 use unamalla_mesh::{DVec2, HasQuadCells, Region};
 
-use crate::CoreError;
+/// Why a picture could not be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// A nodal field has the wrong length.
+    #[error("a nodal field needs one value per node: {values} values for {nodes} nodes")]
+    FieldLength {
+        /// Values given.
+        values: usize,
+        /// Nodes of the mesh.
+        nodes: usize,
+    },
+    /// A nodal field value is NaN or infinite.
+    #[error("the nodal field is not finite at node {node}")]
+    FieldNotFinite {
+        /// The first such node.
+        node: usize,
+    },
+    /// The picture would be empty or too large for the rasterizer.
+    #[error("image size out of range")]
+    ImageSize,
+    /// The PNG encoder failed.
+    #[error("PNG encoding failed: {0}")]
+    Png(String),
+}
 
 /// Colour of μ ≥ 0.8.
 pub const BLUE: [u8; 3] = [0x1f, 0x77, 0xb4];
@@ -83,18 +107,15 @@ fn field_cell_colour(values: &[f64]) -> impl Fn(usize, &[DVec2; 4], [usize; 4]) 
     }
 }
 
-fn check_field<M: HasQuadCells + ?Sized>(mesh: &M, values: &[f64]) -> Result<(), CoreError> {
+fn check_field<M: HasQuadCells + ?Sized>(mesh: &M, values: &[f64]) -> Result<(), RenderError> {
     if values.len() != mesh.num_nodes() {
-        return Err(CoreError::Unsupported(format!(
-            "a nodal field needs one value per node: {} values for {} nodes",
-            values.len(),
-            mesh.num_nodes()
-        )));
+        return Err(RenderError::FieldLength {
+            values: values.len(),
+            nodes: mesh.num_nodes(),
+        });
     }
     if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-        return Err(CoreError::Unsupported(format!(
-            "the nodal field is not finite at node {k}"
-        )));
+        return Err(RenderError::FieldNotFinite { node: k });
     }
     Ok(())
 }
@@ -106,7 +127,7 @@ pub fn field_svg<M: HasQuadCells + ?Sized>(
     values: &[f64],
     region: Option<&Region>,
     width_px: f64,
-) -> Result<String, CoreError> {
+) -> Result<String, RenderError> {
     check_field(mesh, values)?;
     let col = field_cell_colour(values);
     Ok(cells_svg(mesh, region, width_px, &|c, q| {
@@ -120,7 +141,7 @@ pub fn field_png<M: HasQuadCells + ?Sized>(
     values: &[f64],
     region: Option<&Region>,
     width_px: u32,
-) -> Result<Vec<u8>, CoreError> {
+) -> Result<Vec<u8>, RenderError> {
     check_field(mesh, values)?;
     let col = field_cell_colour(values);
     cells_png(mesh, region, width_px, &|c, q| col(c, q, mesh.quad(c)))
@@ -162,7 +183,7 @@ pub fn quality_png<M: HasQuadCells + ?Sized>(
     mesh: &M,
     region: Option<&Region>,
     width_px: u32,
-) -> Result<Vec<u8>, CoreError> {
+) -> Result<Vec<u8>, RenderError> {
     cells_png(mesh, region, width_px, &|_, q| mu_color(mu(q)))
 }
 
@@ -173,7 +194,7 @@ fn cells_png<M: HasQuadCells + ?Sized>(
     region: Option<&Region>,
     width_px: u32,
     colour: &dyn Fn(usize, &[DVec2; 4]) -> [u8; 3],
-) -> Result<Vec<u8>, CoreError> {
+) -> Result<Vec<u8>, RenderError> {
     use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
     let (lo, hi) = bounds(mesh);
     let ext = (hi - lo).max(DVec2::splat(f64::MIN_POSITIVE));
@@ -181,8 +202,7 @@ fn cells_png<M: HasQuadCells + ?Sized>(
     let width = width_px.clamp(64, 8192) as f64;
     let scale = (width - 2.0 * margin) / ext.x.max(ext.y * 1e-3);
     let height = (ext.y * scale + 2.0 * margin).clamp(16.0, 16384.0);
-    let mut pix = Pixmap::new(width as u32, height as u32)
-        .ok_or_else(|| CoreError::Unsupported("image size out of range".into()))?;
+    let mut pix = Pixmap::new(width as u32, height as u32).ok_or(RenderError::ImageSize)?;
     pix.fill(Color::WHITE);
     let px = |p: DVec2| {
         (
@@ -247,7 +267,7 @@ fn cells_png<M: HasQuadCells + ?Sized>(
         }
     }
     pix.encode_png()
-        .map_err(|e| CoreError::Unsupported(format!("PNG encoding failed: {e}")))
+        .map_err(|e| RenderError::Png(e.to_string()))
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 use unamalla_mesh::tfi::sides_from_ring;
 use unamalla_mesh::{tfi2, Region, StructuredGrid2, TfiParams};
 
-use crate::corners::auto_corners;
+use crate::corners::{auto_corners, CornersError};
 use crate::CoreError;
 
 /// How the four corners are chosen.
@@ -43,11 +43,12 @@ pub fn resolve_corners(
         Corners::Input(c) => {
             let mut s = [0usize; 4];
             for (k, &i) in c.iter().enumerate() {
-                s[k] = region.outer_index_from_input(i).ok_or_else(|| {
-                    CoreError::Corners(format!(
-                        "corner index {i} is not a vertex of the outer ring as given (the ring has {len} vertices after cleaning)"
-                    ))
-                })?;
+                s[k] = region.outer_index_from_input(i).ok_or(CoreError::Corners(
+                    CornersError::NotAVertex {
+                        index: i,
+                        vertices: len,
+                    },
+                ))?;
             }
             // order counter-clockwise starting at the first given corner
             let first = s[0];
@@ -56,9 +57,9 @@ pub fn resolve_corners(
             rel.sort_unstable();
             rel.dedup_by_key(|r| r.0);
             if rel.len() != 4 {
-                return Err(CoreError::Corners(format!(
-                    "corners {c:?} are not four distinct vertices"
-                )));
+                return Err(CoreError::Corners(CornersError::NotDistinct {
+                    corners: *c,
+                }));
             }
             Ok([rel[0].1, rel[1].1, rel[2].1, rel[3].1])
         }
@@ -73,10 +74,9 @@ pub fn tfi_region(
     n: usize,
 ) -> Result<StructuredGrid2, CoreError> {
     if !region.holes().is_empty() {
-        return Err(CoreError::Unsupported(format!(
-            "the region has {} hole(s); a single TFI block needs a simply connected four-sided region (use the block-structured mesher)",
-            region.holes().len()
-        )));
+        return Err(CoreError::HolesInSingleBlock {
+            holes: region.holes().len(),
+        });
     }
     if m < 2 || n < 2 {
         return Err(CoreError::Mesh(unamalla_mesh::MeshError::InvalidSize(
@@ -126,7 +126,7 @@ mod tests {
         let region = Region::new(sq(2.0), vec![sq(1.0)]).unwrap();
         assert!(matches!(
             tfi_region(&region, Corners::Auto, 5, 5),
-            Err(CoreError::Unsupported(_))
+            Err(CoreError::HolesInSingleBlock { .. })
         ));
         let region = Region::new(sq(2.0), vec![]).unwrap();
         assert!(matches!(

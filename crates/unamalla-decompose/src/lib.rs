@@ -191,7 +191,6 @@
 //! validates with errors naming the block, cut, ring or vertex ([`DecomposeError`]).
 //! [`Decomposition::to_svg`] draws blocks, cuts, corners and ids.
 
-#![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod auto;

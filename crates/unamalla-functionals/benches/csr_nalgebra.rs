@@ -10,6 +10,8 @@
 //! * `spmv/ours`: `Csr::mul_vec` (parallel over rows); `spmv/nalgebra`: `&CsrMatrix * &DVector`.
 //!
 //! `cargo bench -p unamalla-functionals --bench csr_nalgebra`
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use std::sync::Arc;
 

@@ -5,6 +5,8 @@
 //!
 //! Sizes can be restricted with the environment variable `UNAMALLA_BENCH_SIZES`, e.g.
 //! `UNAMALLA_BENCH_SIZES=q100,q300,q1000,h20,h50,h100` (the default is all of them).
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use std::sync::Arc;
 use std::time::Duration;

@@ -68,8 +68,7 @@
 //! [`FunctionalSpec::from_name`] and [`evaluate`] back `unamalla eval`; in raw mode the value is
 //! the plain sum of the documented per-triangle terms.
 
-#![warn(missing_docs)]
-// No unwrap/expect in library code: user input must give an error, never a panic (issue #14,
+// No unwrap/expect in library code: user input must give an error, never a panic (see
 // docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 // Index loops mirror the component formulas of the derivatives (i, j, a, b as in the docs).

@@ -10,6 +10,8 @@
 //!   `UNAMALLA_BENCH_1000` is set (ten samples of minutes each on a loaded machine).
 //!
 //! `cargo bench -p unamalla-optim --bench smooth [-- FILTER]`
+// criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
+#![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use unamalla_optim::fixtures::sinusoidal;

@@ -105,7 +105,6 @@
 //! The seed 001 §5 test regions (`cuad2pp`, the one-hole contour, Ivanenko's region) as TFI
 //! grids, and the sinusoidal benchmark region.
 
-#![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 #[cfg(feature = "argmin")]

@@ -1,0 +1,728 @@
+//! Running the pipeline: [`Mesher::mesh_observed`] and its stages, the layout fallbacks,
+//! and the region preparation of steps 1 and 1b.
+
+use super::*;
+
+impl Mesher {
+    /// Target size of the submapping strategy (see the module documentation).
+    fn submap_size(&self, region: &Region) -> f64 {
+        match self.size {
+            MeshSize::Cells(n) => (region.area() / n.max(1) as f64).sqrt(),
+            MeshSize::CellSize(h) => h,
+            MeshSize::Density(d) => {
+                let shortest = region
+                    .rings()
+                    .flat_map(|r| {
+                        let p = r.points();
+                        (0..p.len()).map(move |i| p[i].distance(p[(i + 1) % p.len()]))
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                shortest / d.max(1) as f64
+            }
+        }
+    }
+
+    fn stage(&mut self, s: Stage, msg: &str) {
+        if let Some(f) = self.progress.as_mut() {
+            f(s, msg);
+        }
+    }
+
+    /// Pipeline steps 1 and 1b alone: the region simplified by the contour method
+    /// ([`simplify_for_mesh`]) and then without the boundary features below the cell size
+    /// ([`Mesher::feature_factor`]). The mesher meshes [`PreparedRegion::mesh_region`]; a
+    /// decomposition file must have been made for it or for [`PreparedRegion::simplified`].
+    pub fn prepare_region(&self, region: &Region) -> Result<PreparedRegion, CoreError> {
+        let (simplified, holes_dropped) = match &self.simplify {
+            Some(opts) => {
+                let r = simplify_for_mesh(region, opts)?;
+                let dropped = r.dropped_holes.iter().map(|h| h.hole).collect();
+                (r.region, dropped)
+            }
+            None => (region.clone(), Vec::new()),
+        };
+        let h = match self.size {
+            MeshSize::Cells(n) => Some((simplified.area() / n.max(1) as f64).sqrt()),
+            MeshSize::CellSize(h) => Some(h),
+            MeshSize::Density(_) => None,
+        };
+        let mesh_region = match (h, &self.simplify) {
+            (Some(h), Some(_)) if self.feature_factor > 0.0 => {
+                remove_features_below(&simplified, self.feature_factor * h * h)?
+            }
+            _ => simplified.clone(),
+        };
+        let (mesh_region, necks) = match (h, &self.simplify) {
+            (Some(h), Some(_)) if self.feature_factor > 0.0 && self.neck_factor > 0.0 => {
+                unamalla_contour::cut_narrow_necks(
+                    &mesh_region,
+                    // sharp tips are not truncated: measured at 20,000 cells (θ₋ = 40°) it
+                    // raised chesapeake-bay and norway above 90 % but lost 3 points on
+                    // danish-straits and gulf-of-finland and left newfoundland with a cell
+                    // outside the region (31 of 34 regions at target against 33; docs/results.md)
+                    &unamalla_contour::NeckOptions::new(self.neck_factor * h).with_tip_angle(0.0),
+                )?
+            }
+            _ => (mesh_region, Vec::new()),
+        };
+        Ok(PreparedRegion {
+            simplified,
+            mesh_region,
+            holes_dropped,
+            necks,
+        })
+    }
+
+    /// Runs the pipeline with no smoothing observer.
+    pub fn mesh(self, region: &Region) -> Result<MeshResult, CoreError> {
+        self.mesh_observed(region, &mut NullObserver)
+    }
+
+    /// Runs the pipeline; `observer` sees every smoothing iteration.
+    ///
+    /// Before the work: the size against the memory limit and the vertex count of an
+    /// unsimplified region ([`crate::preflight`]). A stage failure caused by a too-narrow gap
+    /// between rings is reported as such ([`crate::preflight::explain_failure`]). After the
+    /// work, the mesh is checked independently ([`crate::verify::verify_quads`]: convex cells,
+    /// centroids inside the meshed region, its area and hole count; the area against the input
+    /// region within [`INPUT_AREA_TOLERANCE`] unless holes were dropped on purpose); a failure is
+    /// [`CoreError::Guarantee`] unless [`Mesher::allow_non_convex`] was set. When the layout was
+    /// chosen automatically and the mesh has non-convex cells or cells whose centroid lies outside
+    /// the region, the mesh is re-made from the next candidate layouts (at most
+    /// [`LAYOUT_FALLBACKS`] more runs; the report's notes name each layout that failed); when
+    /// the mesh passes but its μ ≥ 0.8 share is below [`Mesher::quality_target`], at most
+    /// [`QUALITY_FALLBACKS`] more candidates are tried and the best share is kept.
+    pub fn mesh_observed(
+        mut self,
+        region: &Region,
+        observer: &mut dyn Observer,
+    ) -> Result<MeshResult, CoreError> {
+        use crate::preflight;
+        let t_start = Instant::now();
+        let h = self.submap_size(region);
+        let limit = preflight::memory_limit()?;
+        let (option, value) = match self.size {
+            MeshSize::Cells(0) => return Err(CoreError::ZeroCells),
+            MeshSize::Cells(n) => ("--cells", n.to_string()),
+            MeshSize::CellSize(h) => ("--cell-size", h.to_string()),
+            MeshSize::Density(d) => ("--density", d.to_string()),
+        };
+        preflight::check_size(
+            option,
+            &value,
+            region.area() / (h * h),
+            "cells",
+            preflight::COST_PER_MESH_CELL,
+            limit,
+        )?;
+        let allow = self.allow_non_convex;
+        if self.simplify.is_none() && self.decomposition.is_none() {
+            preflight::check_unsimplified(region)?;
+            if !allow {
+                preflight::check_narrow_features(region, h)?;
+            }
+        }
+        let verify = |result: &MeshResult| {
+            let mut v = crate::verify::verify_quads(
+                result.mesh.global(),
+                Some(&result.simplified),
+                &crate::verify::VerifyOptions::default(),
+            );
+            if result.report.holes_dropped.is_empty() {
+                v.input_area_defect = Some(result.report.area_change_percent / 100.0);
+                v.input_area_tolerance = Some(INPUT_AREA_TOLERANCE);
+            }
+            v
+        };
+        let mut result = self
+            .mesh_unverified(region, observer)
+            .map_err(|e| preflight::explain_failure(e, region, h))?;
+        let mut v = verify(&result);
+        // fallback: a mesh of an automatically chosen layout with cells left folded (a block
+        // whose transfinite start no untangling can fix, e.g. a side notched deeper than its
+        // cells) or reaching out of the region (a boundary chord that skips a sharp reflex
+        // vertex next to a block corner, with the cell behind it thinner than the excursion) is
+        // re-made from the next candidate layout, best predicted first, at most
+        // [`LAYOUT_FALLBACKS`] times; every attempt is named in the report's notes, and if none
+        // passes, the attempt with the fewest such cells is the one reported
+        let mut failed: Vec<String> = Vec::new();
+        // the layout and the bad cells of the last attempt (the kept one may be an earlier one)
+        let mut last;
+        ((result, v), last) =
+            self.layout_fallback(region, observer, &verify, (result, v), &mut failed);
+        // holes narrower than a cell: with the default hole filter, a failure next to such a
+        // hole is meshed again without every hole narrower than h ([`Mesher::drop_narrow_holes`])
+        if !allow && !v.passed() && self.drop_narrow_holes && h > 0.0 {
+            let default_filter = self
+                .simplify
+                .as_ref()
+                .is_some_and(|o| o.holes == HoleFilter::KeepAll);
+            let narrow = region
+                .holes()
+                .iter()
+                .filter(|hole| unamalla_contour::hole_width(hole) < h)
+                .count();
+            if default_filter && narrow > 0 && preflight::small_hole(&v, region, h).is_some() {
+                let note = format!(
+                    "the mesh keeping every hole failed the guarantee next to a hole narrower than the cell size {h:.4e}; made again without the {narrow} hole(s) narrower than that (a cell size of at most half their width keeps them)"
+                );
+                self.stage(Stage::Decompose, &note);
+                if let Some(o) = self.simplify.as_mut() {
+                    o.holes = HoleFilter::MinWidth(h);
+                }
+                self.excluded_layouts.clear();
+                if let Ok(retry) = self.mesh_unverified(region, observer) {
+                    let rv = verify(&retry);
+                    // the layout fallback once more, on the region without those holes
+                    let mut notes = vec![note];
+                    let ((retry, rv), rv_last) =
+                        self.layout_fallback(region, observer, &verify, (retry, rv), &mut notes);
+                    if rv.passed() {
+                        failed.append(&mut notes);
+                        result = retry;
+                        v = rv;
+                        last = rv_last;
+                    }
+                }
+            }
+        }
+        // quality fallback: a mesh that passed but is below the quality target is re-made from
+        // the next candidate layouts (best predicted first), keeping the best achieved share
+        let mut quality_tries = 0;
+        // the share of the last attempt (the kept one may be an earlier one)
+        let mut last_share = result.report.mu_ge_0_8_percent;
+        while !allow
+            && self.quality_target > 0.0
+            && v.passed()
+            && result.report.mu_ge_0_8_percent < self.quality_target
+            && quality_tries < QUALITY_FALLBACKS
+        {
+            let Some(name) = last.0.take() else {
+                break;
+            };
+            quality_tries += 1;
+            let note = format!(
+                "layout {name} reached μ ≥ 0.8 on {last_share:.1} % of the cells, below the target {} %; re-made from the next candidate layout",
+                self.quality_target
+            );
+            let Some((retry, rv)) =
+                self.remake_excluding(name, note, &mut failed, region, observer, &verify)
+            else {
+                break;
+            };
+            last = (layout_name(&retry), bad_cells(&rv));
+            let share = retry.report.mu_ge_0_8_percent;
+            last_share = share;
+            failed.push(format!(
+                "layout {} reached μ ≥ 0.8 on {share:.1} % ({})",
+                last.0.as_deref().unwrap_or("?"),
+                if !rv.passed() {
+                    "failed the guarantee: not kept"
+                } else if share > result.report.mu_ge_0_8_percent {
+                    "kept"
+                } else {
+                    "not better: not kept"
+                }
+            ));
+            if rv.passed() && share > result.report.mu_ge_0_8_percent {
+                result = retry;
+                v = rv;
+            }
+        }
+        if !failed.is_empty() {
+            result.report.seconds = t_start.elapsed().as_secs_f64();
+            let mut notes = failed;
+            notes.append(&mut result.report.notes);
+            result.report.notes = notes;
+        }
+        result.report.verification = v.clone();
+        if !allow {
+            v.into_result()
+                .map_err(|e| preflight::explain_guarantee(e, region, h))?;
+        }
+        Ok(result)
+    }
+
+    /// The layout fallback of [`Mesher::mesh_observed`]: while the kept attempt `best` fails
+    /// the guarantee with non-convex cells or cells outside the region, the mesh is re-made from
+    /// the next candidate layout (the last attempt's layout excluded), at most
+    /// [`LAYOUT_FALLBACKS`] times, each named in `notes`; the attempt with the fewest such cells
+    /// is kept (the earlier on a tie; a passing one always). Returns the kept attempt and the
+    /// layout and bad-cell count of the last one.
+    fn layout_fallback(
+        &mut self,
+        region: &Region,
+        observer: &mut dyn Observer,
+        verify: &dyn Fn(&MeshResult) -> crate::verify::Verification,
+        best: (MeshResult, crate::verify::Verification),
+        notes: &mut Vec<String>,
+    ) -> (
+        (MeshResult, crate::verify::Verification),
+        (Option<String>, usize),
+    ) {
+        let (mut result, mut v) = best;
+        let mut last = (layout_name(&result), bad_cells(&v));
+        let mut tries = 0;
+        while !self.allow_non_convex && !v.passed() && last.1 > 0 && tries < LAYOUT_FALLBACKS {
+            let (Some(name), bad) = (last.0.take(), last.1) else {
+                break;
+            };
+            tries += 1;
+            let note = format!(
+                "layout {name} left {bad} cell(s) non-convex or outside the region; re-made from the next candidate layout"
+            );
+            // no candidate left, or the next one fails in a stage: keep what we have
+            let Some((retry, rv)) =
+                self.remake_excluding(name, note, notes, region, observer, verify)
+            else {
+                break;
+            };
+            last = (layout_name(&retry), bad_cells(&rv));
+            if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
+                result = retry;
+                v = rv;
+            }
+        }
+        ((result, v), last)
+    }
+
+    /// One retry of the fallbacks of [`Mesher::mesh_observed`]: `note` goes to the progress
+    /// line and to `notes`, layout `name` is excluded, and the mesh is re-made from the next
+    /// candidate layout and verified; `None` when no candidate is left or a stage fails.
+    fn remake_excluding(
+        &mut self,
+        name: String,
+        note: String,
+        notes: &mut Vec<String>,
+        region: &Region,
+        observer: &mut dyn Observer,
+        verify: &dyn Fn(&MeshResult) -> crate::verify::Verification,
+    ) -> Option<(MeshResult, crate::verify::Verification)> {
+        self.stage(Stage::Decompose, &note);
+        notes.push(note);
+        self.excluded_layouts.push(name);
+        let retry = self.mesh_unverified(region, observer).ok()?;
+        let rv = verify(&retry);
+        Some((retry, rv))
+    }
+
+    /// The pipeline without the checks of [`Mesher::mesh_observed`].
+    fn mesh_unverified(
+        &mut self,
+        region: &Region,
+        observer: &mut dyn Observer,
+    ) -> Result<MeshResult, CoreError> {
+        let t0 = Instant::now();
+        let mut stage_seconds = Vec::new();
+        let mut timer = Instant::now();
+        let mut lap = |s: Stage, timer: &mut Instant| {
+            stage_seconds.push((s, timer.elapsed().as_secs_f64()));
+            *timer = Instant::now();
+        };
+
+        // 1. simplify, 1b. remove the features below the cell size
+        self.stage(Stage::Simplify, "simplifying the contour");
+        let prepared = self.prepare_region(region)?;
+        let holes_dropped = prepared.holes_dropped;
+        let neck_notes: Vec<String> = prepared.necks.iter().map(|c| c.to_string()).collect();
+        // a decomposition file fits either region: ours (saved by a previous run) fits the one
+        // without features, one made by hand for the simplified region fits the other
+        // (validated here, once: the error names the simplified region when neither fits)
+        let simplified = match &self.decomposition {
+            Some(d) if d.validate(&prepared.mesh_region).is_err() => {
+                d.validate(&prepared.simplified)?;
+                prepared.simplified
+            }
+            _ => prepared.mesh_region,
+        };
+        lap(Stage::Simplify, &mut timer);
+
+        // 2–6 by submapping (seed 002) when the strategy asks for it
+        // notes of step 3 for the report (cells the counts cannot avoid)
+        let mut counts_notes: Vec<String> = Vec::new();
+        let submapping = match (self.strategy, self.decomposition.is_some()) {
+            (Strategy::Submap, true) => return Err(CoreError::DecompositionWithSubmap),
+            (Strategy::Submap, false) => {
+                self.stage(Stage::Decompose, "submapping (seed 002)");
+                Some(submap(
+                    &simplified,
+                    &SubmapOptions::new(self.submap_size(&simplified)),
+                )?)
+            }
+            (Strategy::Auto, false) if prefers_submap(&simplified, AUTO_ANGLE_TOLERANCE_DEG) => {
+                self.stage(Stage::Decompose, "submapping (seed 002, automatic choice)");
+                submap(
+                    &simplified,
+                    &SubmapOptions::new(self.submap_size(&simplified)),
+                )
+                .ok()
+            }
+            _ => None,
+        };
+        let mut layout_choice: Option<LayoutChoice> = None;
+        let (decomposition, counts, mut mesh) = match submapping.as_ref() {
+            Some(s) => {
+                lap(Stage::Decompose, &mut timer);
+                lap(Stage::Counts, &mut timer);
+                self.stage(Stage::Tfi, "transfinite interpolation per piece");
+                let grids = s.grids()?;
+                lap(Stage::Tfi, &mut timer);
+                self.stage(Stage::Merge, "merging pieces");
+                let mesh = BlockMesh2::merge(grids, 1e-9)?;
+                lap(Stage::Merge, &mut timer);
+                (s.to_decomposition(), None, mesh)
+            }
+            None => {
+                // 2. decompose
+                self.stage(Stage::Decompose, "decomposing into blocks");
+                let decomposition = match self.decomposition.take() {
+                    Some(d) => d,
+                    None => {
+                        // the chord layout samples the boundary at the cell size
+                        let mut opts = self.decompose_opts.clone();
+                        if opts.cell_size.is_none() {
+                            opts.cell_size = match self.size {
+                                MeshSize::Cells(n) => {
+                                    Some((simplified.area() / n.max(1) as f64).sqrt())
+                                }
+                                MeshSize::CellSize(h) => Some(h),
+                                MeshSize::Density(_) => None,
+                            };
+                        }
+                        match self.layout {
+                            Some(l) => {
+                                opts.layout = l;
+                                decompose(&simplified, &opts)?
+                            }
+                            None => {
+                                let (d, choice) = choose_layout_excluding(
+                                    &simplified,
+                                    &opts,
+                                    self.size,
+                                    &self.excluded_layouts,
+                                )?;
+                                layout_choice = Some(choice);
+                                d
+                            }
+                        }
+                    }
+                };
+                lap(Stage::Decompose, &mut timer);
+
+                // 3. compatible counts
+                self.stage(Stage::Counts, "solving for compatible point counts");
+                let step3 = crate::curves::compatible_counts(&decomposition, self.size)?;
+                counts_notes = step3.notes;
+                let (curves, counts) = (step3.curves, step3.solution);
+                lap(Stage::Counts, &mut timer);
+
+                // 4–5. reparametrize + TFI
+                self.stage(Stage::Tfi, "transfinite interpolation per block");
+                let grids = curves.grids(&decomposition, &counts.counts)?;
+                lap(Stage::Tfi, &mut timer);
+
+                // 6. merge
+                self.stage(Stage::Merge, "merging blocks");
+                let mesh = BlockMesh2::merge(grids, 1e-9)?;
+                lap(Stage::Merge, &mut timer);
+                (decomposition, Some(counts), mesh)
+            }
+        };
+
+        // 6b. flat block corners on the boundary (triangle blocks): bent outward so their
+        // cells can be convex
+        let bent_corners =
+            crate::flat_corners::bend_flat_corners(&mut mesh, self.flat_corner_deficit);
+
+        // 7. smooth (region boundary fixed, cut nodes free)
+        // (a mesh without interior nodes — every node on the region boundary, e.g. one cell
+        // per block — has nothing to smooth: it is kept as the transfinite interpolation made it)
+        let smoothing_status = if mesh.global().num_free() == 0 {
+            self.stage(Stage::Smooth, "no interior node: nothing to smooth");
+            lap(Stage::Smooth, &mut timer);
+            "not smoothed: the mesh has no interior node".to_string()
+        } else {
+            self.stage(Stage::Smooth, "smoothing (convexity-preserving)");
+            let mut sopts = self.smooth_opts.clone();
+            if let unamalla_optim::SmoothFunctional::BlockSmoothing { density, .. } =
+                &mut sopts.functional
+            {
+                *density = self.boundary_density;
+            }
+            // the explicit time limit (if any) counts from the start of the stage
+            let t_stage = Instant::now();
+            sopts.time_limit = self.time_limit;
+            // 7-. a start prolonged from smoothed coarse levels ([`crate::multilevel`]); when it is
+            // used, the untangling below has nothing to do (the start is convex)
+            let coarse = match (&counts, submapping.is_none()) {
+                (Some(c), true) => crate::multilevel::coarse_start(
+                    &decomposition,
+                    self.size,
+                    &mesh,
+                    &c.counts,
+                    &sopts,
+                    crate::multilevel::CoarseLevels {
+                        levels: self.coarse_levels,
+                        flat_corner_deficit: self.flat_corner_deficit,
+                    },
+                    observer,
+                )?,
+                _ => None,
+            };
+            if let Some(c) = &coarse {
+                self.stage(Stage::Smooth, &c.summary());
+                if c.accepted {
+                    mesh.global_mut().nodes_mut().copy_from_slice(&c.nodes);
+                    sopts = crate::multilevel::polish_options(&sopts);
+                }
+            }
+            // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
+            // block boundaries ([`crate::untangle`]): small problems converge in far fewer
+            // iterations than the global one, the work is bounded by iteration limits (not
+            // wall-clock time, so the result does not depend on the load), and the global run
+            // below then starts convex (or nearly so)
+            let patches = crate::untangle::untangle_patches_observed(
+                mesh.global_mut(),
+                &sopts,
+                &crate::untangle::DEFAULT_PATCH_RADII,
+                observer,
+            )?;
+            if patches.before > 0 {
+                mesh.sync_blocks();
+                let msg = format!(
+                    "untangled {} → {} non-convex cells in {} local patch(es) (radius ≤ {}, {} iterations, {:.2} s)",
+                    patches.before,
+                    patches.after,
+                    patches.patches,
+                    patches.max_radius,
+                    patches.iterations,
+                    t_stage.elapsed().as_secs_f64()
+                );
+                self.stage(Stage::Smooth, &msg);
+                if !patches.unresolved.is_empty() {
+                    let msg = format!(
+                        "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
+                        patches.unresolved.len(),
+                        if patches.cancelled { " (cancelled)" } else { "" },
+                        &patches.unresolved[..patches.unresolved.len().min(8)],
+                        if patches.unresolved.len() > 8 { ", …" } else { "" },
+                    );
+                    self.stage(Stage::Smooth, &msg);
+                }
+            }
+            // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
+            if let Some(t) = self.time_limit {
+                sopts.time_limit = Some((t - t_stage.elapsed().as_secs_f64()).max(0.0));
+            }
+            let smoothing = smooth(&mut mesh, &sopts, observer)?;
+            mesh.sync_blocks();
+            lap(Stage::Smooth, &mut timer);
+            smoothing.status.to_string()
+        };
+
+        // 7c. local shape improvement, the region-boundary nodes sliding along the boundary
+        // ([`unamalla_optim::shape`]): the smoother keeps them where the transfinite
+        // interpolation put them, so rows of cells meeting the boundary obliquely stay sheared
+        let shape = match self.shape.clone() {
+            Some(o) if o.max_sweeps > 0 => {
+                self.stage(Stage::Shape, "shape pass (boundary nodes sliding)");
+                let slide = BoundarySlide::new(mesh.global(), &simplified, o.feature_angle_deg);
+                let r = improve_shape(mesh.global_mut(), Some(&slide), &o, observer);
+                mesh.sync_blocks();
+                self.stage(
+                    Stage::Shape,
+                    &format!(
+                        "shape pass: μ ≥ {} on {:.1} → {:.1} % of the cells ({} sweeps, {} moves, {} slides)",
+                        o.keep, r.good_before, r.good_after, r.sweeps, r.moved, r.slid
+                    ),
+                );
+                lap(Stage::Shape, &mut timer);
+                Some(r)
+            }
+            _ => None,
+        };
+
+        // 8. report
+        self.stage(Stage::Report, "quality report");
+        let quality = QualityReport::for_quads(&mesh);
+        let q = quality.quad.as_ref();
+        let sj = quality.metric("scaled_jacobian");
+        let mesh_area: f64 = (0..mesh.num_quads())
+            .map(|c| polygon_area(&mesh.quad_points(c)))
+            .sum();
+        let area_change_percent = (mesh_area - region.area()).abs() / region.area() * 100.0;
+        let hausdorff = boundary_hausdorff(&mesh, region);
+        lap(Stage::Report, &mut timer);
+        let report = MeshReport {
+            region: String::new(),
+            cells: mesh.num_quads(),
+            nodes: mesh.num_nodes(),
+            blocks: mesh.blocks().len(),
+            strategy: if submapping.is_some() {
+                Strategy::Submap
+            } else {
+                Strategy::Cuts
+            },
+            non_convex_cells: quality.non_convex_cells,
+            interior_singularities: q.map_or(0, |q| q.interior_singularities),
+            bent_corners,
+            mu_ge_0_8_percent: q.map_or(0.0, |q| q.mu_bands.good),
+            mu_bands: q.map_or([0.0; 3], |q| {
+                [q.mu_bands.good, q.mu_bands.fair, q.mu_bands.poor]
+            }),
+            min_scaled_jacobian: sj.map_or(f64::NAN, |m| m.min),
+            p5_scaled_jacobian: sj.map_or(f64::NAN, |m| m.p5),
+            min_alpha_over_mean: q.map_or(f64::NAN, |q| q.alpha_min_ratio),
+            area_change_percent,
+            hausdorff,
+            holes_dropped,
+            smoothing: smoothing_status,
+            shape,
+            seconds: t0.elapsed().as_secs_f64(),
+            stage_seconds,
+            block_quality: layout_choice
+                .as_ref()
+                .map(|c| {
+                    c.blocks
+                        .iter()
+                        .enumerate()
+                        .filter(|(b, _)| *b < mesh.blocks().len())
+                        .map(|(b, &p)| {
+                            let (a, cells) = crate::predict::block_good_share(&mesh, b);
+                            BlockQuality {
+                                block: b,
+                                cells,
+                                predicted: 100.0 * p,
+                                achieved: 100.0 * a,
+                            }
+                        })
+                        .collect()
+                })
+                .unwrap_or_default(),
+            layout: layout_choice,
+            quality,
+            notes: neck_notes.into_iter().chain(counts_notes).collect(),
+            verification: Default::default(),
+        };
+        Ok(MeshResult {
+            simplified,
+            decomposition,
+            counts,
+            submap: submapping,
+            mesh,
+            report,
+        })
+    }
+}
+
+/// The region after pipeline steps 1 and 1b ([`Mesher::prepare_region`]).
+#[derive(Debug, Clone)]
+pub struct PreparedRegion {
+    /// After the contour simplification ([`simplify_for_mesh`]); the input region itself
+    /// without simplification.
+    pub simplified: Region,
+    /// After the removal of boundary features below the cell size: the region that is meshed.
+    pub mesh_region: Region,
+    /// Input holes dropped by the simplification (indices in input order).
+    pub holes_dropped: Vec<usize>,
+    /// Spits and inlets cut off at their necks ([`Mesher::neck_factor`]).
+    pub necks: Vec<unamalla_contour::NeckCut>,
+}
+
+/// Largest relative area change (a fraction) the pipeline accepts from the contour
+/// simplification before it retries with a smaller threshold (see [`simplify_for_mesh`]).
+pub const MAX_SIMPLIFY_AREA_CHANGE: f64 = 0.01;
+
+/// The contour simplification of pipeline step 1: [`simplify_region`] with `opts`, retried with
+/// the threshold ε halved (at most six times) while the region's area changes by more than
+/// [`MAX_SIMPLIFY_AREA_CHANGE`] — unless the finer result has a vertex almost touching another
+/// edge (closer than 10⁻⁶ of the region's size), which the coarser one had removed. The thesis's default thresholds are tuned for dense, noisy
+/// contours; on a coarse silhouette of a few dozen vertices the same ε removes real shape (the
+/// bundled `horse` lost 2.1 % of its area). Use this function to reproduce the pipeline's
+/// simplified region (e.g. to validate a decomposition file against it).
+pub fn simplify_for_mesh(
+    region: &Region,
+    opts: &SimplifyOptions,
+) -> Result<unamalla_contour::SimplifyResult, CoreError> {
+    let mut r = simplify_region(region, opts)?;
+    for _ in 0..6 {
+        if r.relative_area_change.abs() <= MAX_SIMPLIFY_AREA_CHANGE {
+            break;
+        }
+        let smaller = SimplifyOptions {
+            epsilon: Some(0.5 * r.epsilon),
+            ..opts.clone()
+        };
+        let retry = simplify_region(region, &smaller)?;
+        // keep the coarser result when the finer one brings back a near contact (a vertex
+        // within 10⁻⁶ of the region's size of a non-adjacent edge): no mesh can resolve it
+        if nearly_touching(&retry.region, 1e-6) {
+            break;
+        }
+        r = retry;
+    }
+    Ok(r)
+}
+
+/// Whether some vertex of `region` lies within `rel·diag` (diag = bounding-box diagonal) of an
+/// edge of any ring other than its two own edges.
+fn nearly_touching(region: &Region, rel: f64) -> bool {
+    let (lo, hi) = region.bounding_box();
+    let tol = rel * (hi - lo).length();
+    let index = region.edge_index();
+    let rings = index.rings();
+    rings.iter().enumerate().any(|(ri, ring)| {
+        let n = ring.len();
+        ring.iter().enumerate().any(|(i, &p)| {
+            let d = DVec2::splat(tol);
+            index.candidates(p - d, p + d).any(|e| {
+                let own = e.ring == ri && (e.edge == i || (e.edge + 1) % n == i);
+                let (a, b) = index.edge(e);
+                !own && unamalla_mesh::geometry::point_segment_distance(p, a, b) <= tol
+            })
+        })
+    })
+}
+
+/// The automatically chosen layout of a mesh (`None`: the layout was given).
+fn layout_name(result: &MeshResult) -> Option<String> {
+    result.report.layout.as_ref().map(|c| c.layout.clone())
+}
+
+/// The cells a layout fallback counts against an attempt: non-convex, or with the centroid
+/// outside the region.
+fn bad_cells(v: &crate::verify::Verification) -> usize {
+    v.non_convex_cells + v.centroids_outside.unwrap_or(0)
+}
+
+fn polygon_area(p: &[DVec2]) -> f64 {
+    unamalla_mesh::region::signed_area(p)
+}
+
+/// The Hausdorff distance between the mesh's boundary loops and the region's rings: each mesh
+/// loop is compared with the input ring it approximates (the outer loop with the outer ring, each
+/// hole loop with the input hole whose centroid is nearest).
+fn boundary_hausdorff(mesh: &BlockMesh2, region: &Region) -> f64 {
+    let loops = unamalla_io::msh::boundary_loops(mesh);
+    let nodes = mesh.nodes();
+    let centroid = |p: &[DVec2]| p.iter().copied().sum::<DVec2>() / p.len().max(1) as f64;
+    let mut worst: f64 = 0.0;
+    for l in &loops {
+        let pts: Vec<DVec2> = l.edges.iter().map(|e| nodes[e[0]]).collect();
+        let target = if l.signed_area > 0.0 {
+            region.outer().points()
+        } else {
+            let c = centroid(&pts);
+            match region.holes().iter().min_by(|a, b| {
+                centroid(a.points())
+                    .distance(c)
+                    .total_cmp(&centroid(b.points()).distance(c))
+            }) {
+                Some(h) => h.points(),
+                None => continue,
+            }
+        };
+        worst = worst.max(unamalla_contour::hausdorff(&pts, target));
+    }
+    worst
+}
