@@ -7,8 +7,9 @@
 use std::time::Instant;
 
 use unamalla_core::compat_ilp as ilp;
-use unamalla_core::curves::{compatible_counts, decomposition_area, BlockCurves};
+use unamalla_core::curves::{compatible_counts, decomposition_area};
 use unamalla_core::decompose::decompose;
+use unamalla_core::decompose::BlockCurves;
 use unamalla_core::pipeline::{MeshSize, Mesher};
 
 fn main() {

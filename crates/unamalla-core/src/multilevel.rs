@@ -19,7 +19,7 @@
 //!
 //! **Transfer in index space.** Node `(i, j)` of fine block `k` is mapped to a fractional index
 //! `(s, t)` of coarse block `k` by piecewise-linear maps along each side whose breakpoints are
-//! the curve junctions of the side (the curves `Q_j` of [`crate::curves::BlockCurves`]: a curve
+//! the curve junctions of the side (the curves `Q_j` of [`BlockCurves`]: a curve
 //! with `m_j` fine and `m'_j` coarse points spans `m_j − 1` fine and `m'_j − 1` coarse
 //! segments), blended transfinitely inside the block:
 //! `s = (1−η)·B(i) + η·T(i)`, `t = (1−ξ)·L(j) + ξ·R(j)`, `ξ = i/(m−1)`, `η = j/(n−1)`.
@@ -41,9 +41,10 @@ use unamalla_mesh::quality::non_convex_cells;
 use unamalla_mesh::{BlockMesh2, DVec2, FreeNodes, HasNodes, HasQuadCells};
 use unamalla_optim::{smooth, Observer, SmoothOptions};
 
-use crate::curves::{compatible_counts, BlockCurves};
+use crate::curves::compatible_counts;
 use crate::pipeline::MeshSize;
 use crate::CoreError;
+use unamalla_decompose::BlockCurves;
 
 /// The coarse level has about `1 / COARSE_CELL_RATIO` of the cells of the level above (half the
 /// points per block side).

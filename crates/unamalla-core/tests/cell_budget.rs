@@ -116,7 +116,7 @@ fn a_cell_size_gives_the_matching_count() {
 
 #[test]
 fn resampling_keeps_the_corners_of_a_boundary_curve() {
-    use unamalla_core::curves::resample_keeping_corners;
+    use unamalla_core::decompose::curves::resample_keeping_corners;
     // an L of two legs of 10 with 4 points: by arc length alone (3 segments of 20/3) the corner
     // (10, 0) would be cut by the chord (20/3, 0)–(10, 10/3); kept, the legs share the 3
     // segments 2 + 1 (shares 1 + ½ each, the tie to the first leg)
@@ -147,7 +147,7 @@ fn resampling_keeps_the_corners_of_a_boundary_curve() {
 
 #[test]
 fn the_resolution_bound_follows_the_sagitta() {
-    use unamalla_core::curves::{chord_deviation, points_for_deviation};
+    use unamalla_core::decompose::curves::{chord_deviation, points_for_deviation};
     // a half circle of radius 10 as a 100-gon (turns of 1.8°: no corner is kept). m points give
     // chords over π/(m−1) with sagitta 10·(1 − cos(π/(2(m−1)))): 0.1018 for m = 12, 0.0855 for
     // m = 13; the 100-gon's vertices sit up to 10·(1 − cos(π/198)) = 0.0013 off the circle, so the

@@ -198,6 +198,7 @@ pub mod chords;
 pub mod concavity;
 pub mod corners;
 pub mod corners_diametral;
+pub mod curves;
 mod decomposition;
 pub mod error;
 pub mod file;
@@ -214,5 +215,6 @@ pub use auto::{
 pub use concavity::{concavity, critical_angles, is_admissible, Concavity, Pocket, Tolerances};
 pub use corners::{select_corners, CornerWeights};
 pub use corners_diametral::CornerChoice;
+pub use curves::BlockCurves;
 pub use decomposition::{Block, Cut, Decomposition, EdgeKind, SideCurve, Step, TreeNode};
 pub use error::DecomposeError;
