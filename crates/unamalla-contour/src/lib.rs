@@ -98,7 +98,3 @@ pub use simplify::{
     HoleFilter, Method, Preset, RingReport, SimplifyOptions, SimplifyResult, SubsetHausdorff,
 };
 
-/// Absolute shoelace area of an open ring.
-pub(crate) fn signed_area_abs(ring: &[glam::DVec2]) -> f64 {
-    unamalla_mesh::region::signed_area(ring).abs()
-}

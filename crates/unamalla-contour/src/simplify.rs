@@ -364,7 +364,7 @@ pub fn simplify_region(
         .zip(&input)
         .enumerate()
         .map(|(k, (s, orig))| {
-            let a0 = crate::signed_area_abs(orig);
+            let a0 = unamalla_mesh::region::signed_area(orig).abs();
             // vertex-removal methods: the per-edge chain scan (exact when certified, see
             // `subset_hausdorff`); methods that move points: the sampled distance
             let h = match kept_ids.as_ref().and_then(|ids| ids.get(k)) {

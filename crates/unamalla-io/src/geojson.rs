@@ -28,6 +28,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+use unamalla_mesh::region::signed_area;
 use unamalla_mesh::{DVec2, Region};
 
 use crate::error::IoError;
@@ -58,28 +59,13 @@ pub struct PolygonRings {
 impl PolygonRings {
     /// Area enclosed by the outer ring (absolute value of the shoelace formula), holes ignored.
     pub fn outer_area(&self) -> f64 {
-        ring_area(&self.outer)
+        signed_area(&self.outer).abs()
     }
 
     /// Total number of vertices over all rings (closing positions not counted).
     pub fn num_vertices(&self) -> usize {
         self.outer.len() + self.holes.iter().map(Vec::len).sum::<usize>()
     }
-}
-
-/// Absolute area of a ring given open or closed (shoelace formula).
-fn ring_area(ring: &[DVec2]) -> f64 {
-    let n = ring.len();
-    if n < 3 {
-        return 0.0;
-    }
-    let mut s = 0.0;
-    for k in 0..n {
-        let a = ring[k];
-        let b = ring[(k + 1) % n];
-        s += a.perp_dot(b);
-    }
-    0.5 * s.abs()
 }
 
 /// Reads a region from a GeoJSON file: the selected polygonal part, validated by

@@ -44,6 +44,7 @@
 
 use std::path::Path;
 
+use unamalla_mesh::region::signed_area;
 use unamalla_mesh::{DVec2, DVec3, GeometryError, HasNodes, Region, StructuredGrid2};
 
 use crate::atomic::atomic_write;
@@ -225,7 +226,7 @@ impl Contour {
             Some((a, b)) => {
                 let s = self.sides();
                 let (la, lb) = (open(s[a]), open(s[b]));
-                if area(&la) >= area(&lb) {
+                if signed_area(&la).abs() >= signed_area(&lb).abs() {
                     Region::new(la, vec![lb])
                 } else {
                     Region::new(lb, vec![la])
@@ -233,15 +234,6 @@ impl Contour {
             }
         }
     }
-}
-
-fn area(r: &[DVec2]) -> f64 {
-    let n = r.len();
-    (0..n)
-        .map(|k| r[k].perp_dot(r[(k + 1) % n]))
-        .sum::<f64>()
-        .abs()
-        / 2.0
 }
 
 /// Reads a `.con` contour file.

@@ -79,6 +79,7 @@
 use std::path::Path;
 
 use unamalla_mesh::geometry::orient2d;
+use unamalla_mesh::region::signed_area;
 use unamalla_mesh::{DVec2, Region};
 
 use crate::atomic::atomic_write;
@@ -162,23 +163,12 @@ fn open_ring(points: Vec<DVec2>) -> Vec<DVec2> {
     p
 }
 
-/// Twice the signed area of an open ring, summed as a fan from its first vertex:
-/// `Σ_k (p_k − p_0) × (p_{k+1} − p_0)`; positive for counter-clockwise rings.
-fn twice_signed_area(ring: &[DVec2]) -> f64 {
-    let Some(&p0) = ring.first() else {
-        return 0.0;
-    };
-    ring.windows(2)
-        .map(|w| (w[0] - p0).perp_dot(w[1] - p0))
-        .sum()
-}
-
 /// Orientation of an open ring: `> 0` counter-clockwise, `< 0` clockwise. Decided exactly by
 /// `orient2d` (Shewchuk's adaptive predicate) at the lexicographically smallest vertex and its
 /// nearest distinct neighbours — for a simple ring that vertex is a convex corner, so the sign
 /// is the sign of the area with no rounding (the same rule as `unamalla_mesh::Region`). When
 /// that turn is degenerate (a collinear spike, or a ring that is not simple) the rounded fan
-/// area [`twice_signed_area`] decides.
+/// area ([`signed_area`], a fan from the first vertex) decides.
 fn orientation(ring: &[DVec2]) -> f64 {
     let n = ring.len();
     let Some((k, &v)) = ring
@@ -197,7 +187,7 @@ fn orientation(ring: &[DVec2]) -> f64 {
     if turn != 0.0 {
         turn
     } else {
-        twice_signed_area(ring)
+        signed_area(ring)
     }
 }
 
@@ -642,21 +632,5 @@ mod tests {
         ];
         assert!(inside(DVec2::new(1.0, 1.0), &sq));
         assert!(!inside(DVec2::new(3.0, 1.0), &sq));
-    }
-
-    #[test]
-    fn fan_area_sign_and_value() {
-        // unit square counter-clockwise: twice the area is 2
-        let sq = [
-            DVec2::new(0.0, 0.0),
-            DVec2::new(1.0, 0.0),
-            DVec2::new(1.0, 1.0),
-            DVec2::new(0.0, 1.0),
-        ];
-        assert_eq!(twice_signed_area(&sq), 2.0);
-        let mut cw = sq.to_vec();
-        cw.reverse();
-        assert_eq!(twice_signed_area(&cw), -2.0);
-        assert_eq!(twice_signed_area(&[]), 0.0);
     }
 }

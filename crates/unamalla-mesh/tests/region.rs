@@ -291,3 +291,24 @@ fn large_ring_validates_quickly() {
     // generous bound for slow CI machines; the measured figure is in docs/benchmarks.md
     assert!(dt.as_secs_f64() < 5.0, "took {dt:?}");
 }
+
+/// The one signed-area function of the workspace (`region::signed_area`, used by every crate):
+/// sign by orientation, value by hand, open or closed rings, and nothing for an empty ring.
+#[test]
+fn the_free_signed_area_by_hand() {
+    use unamalla_mesh::region::signed_area;
+    let sq = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(2.0, 0.0),
+        DVec2::new(2.0, 3.0),
+        DVec2::new(0.0, 3.0),
+    ];
+    assert_eq!(signed_area(&sq), 6.0);
+    let mut closed = sq.to_vec();
+    closed.push(sq[0]);
+    assert_eq!(signed_area(&closed), 6.0);
+    let mut cw = sq.to_vec();
+    cw.reverse();
+    assert_eq!(signed_area(&cw), -6.0);
+    assert_eq!(signed_area(&[]), 0.0);
+}

@@ -548,7 +548,7 @@ impl Mesher {
         let q = quality.quad.as_ref();
         let sj = quality.metric("scaled_jacobian");
         let mesh_area: f64 = (0..mesh.num_quads())
-            .map(|c| polygon_area(&mesh.quad_points(c)))
+            .map(|c| unamalla_mesh::region::signed_area(&mesh.quad_points(c)))
             .sum();
         let area_change_percent = (mesh_area - region.area()).abs() / region.area() * 100.0;
         let hausdorff = boundary_hausdorff(&mesh, region);
@@ -693,10 +693,6 @@ fn layout_name(result: &MeshResult) -> Option<String> {
 /// outside the region.
 fn bad_cells(v: &crate::verify::Verification) -> usize {
     v.non_convex_cells + v.centroids_outside.unwrap_or(0)
-}
-
-fn polygon_area(p: &[DVec2]) -> f64 {
-    unamalla_mesh::region::signed_area(p)
 }
 
 /// The Hausdorff distance between the mesh's boundary loops and the region's rings: each mesh
