@@ -97,20 +97,15 @@ pub struct BoundaryLoop {
 /// returned as is.
 pub fn boundary_loops<M: HasQuadCells + ?Sized>(mesh: &M) -> Vec<BoundaryLoop> {
     let nc = mesh.num_quads();
-    let mut count: HashMap<(usize, usize), u32> = HashMap::with_capacity(nc * 2);
-    for c in 0..nc {
-        let q = mesh.quad(c);
-        for k in 0..4 {
-            let (a, b) = (q[k], q[(k + 1) % 4]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
+    // the boundary edges (used by one cell, sorted) from the mesh crate's edge census, then
+    // oriented as their cell runs them, in cell order
+    let boundary = unamalla_mesh::quality::quad_boundary_edges(mesh);
     let mut bedges: Vec<[usize; 2]> = Vec::new();
     for c in 0..nc {
         let q = mesh.quad(c);
         for k in 0..4 {
             let (a, b) = (q[k], q[(k + 1) % 4]);
-            if count.get(&(a.min(b), a.max(b))) == Some(&1) {
+            if a != b && boundary.binary_search(&[a.min(b), a.max(b)]).is_ok() {
                 bedges.push([a, b]);
             }
         }

@@ -93,18 +93,11 @@ impl BlockMesh2 {
             }
         }
         // conformity: every edge in at most two cells
-        let mut edge_count: HashMap<(usize, usize), u32> = HashMap::with_capacity(cells.len() * 2);
-        for c in &cells {
-            for k in 0..4 {
-                let (a, b) = (c[k], c[(k + 1) % 4]);
-                let e = edge_count.entry((a.min(b), a.max(b))).or_insert(0);
-                *e += 1;
-                if *e > 2 {
-                    return Err(MeshError::Degenerate(format!(
-                        "edge between global nodes {a} and {b} is shared by more than two cells; blocks overlap"
-                    )));
-                }
-            }
+        let census = crate::quality::mesh::quad_edge_counts(cells.iter().copied(), cells.len());
+        if let Some(((a, b), _)) = census.into_iter().find(|&(_, n)| n > 2) {
+            return Err(MeshError::Degenerate(format!(
+                "edge between global nodes {a} and {b} is shared by more than two cells; blocks overlap"
+            )));
         }
         let global = QuadMesh::new(nodes, cells)?;
         Ok(Self {

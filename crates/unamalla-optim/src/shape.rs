@@ -314,19 +314,10 @@ impl BoundarySlide {
         let tol = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
         let fixed = mesh.fixed();
         let nodes = unamalla_mesh::HasNodes::nodes(mesh);
-        // boundary edges: cell edges with both ends fixed used by one cell
-        let mut uses: HashMap<(usize, usize), u32> = HashMap::new();
-        for c in mesh.cells() {
-            for k in 0..4 {
-                let (a, b) = (c[k], c[(k + 1) % 4]);
-                if fixed[a] && fixed[b] {
-                    *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-                }
-            }
-        }
+        // boundary edges (used by one cell) with both ends fixed
         let mut nbrs: HashMap<usize, Vec<usize>> = HashMap::new();
-        for (&(a, b), &n) in &uses {
-            if n == 1 {
+        for [a, b] in unamalla_mesh::quality::quad_boundary_edges(mesh) {
+            if fixed[a] && fixed[b] {
                 nbrs.entry(a).or_default().push(b);
                 nbrs.entry(b).or_default().push(a);
             }
