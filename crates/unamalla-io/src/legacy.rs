@@ -1,4 +1,4 @@
-//! The file formats of UNAMALLA v2.0 (seed 001 digest §7.4): contours (`.con`), meshes in
+//! The file formats of UNAMALLA v2.0 ([González Flores, §A.5]): contours (`.con`), meshes in
 //! "classic" XY and "recent" RED order, and the Geomview `MESH` surface file.
 //!
 //! All are ASCII. UNAMALLA writes numbers in Fortran `F11.4` and reads them in free format
@@ -38,8 +38,8 @@
 //!
 //! `MESH`, then `Nu Nv`, then `Nu·Nv` lines `x y z` with `u` varying fastest (Geomview's
 //! definition). [`write_geomview_mesh`] writes `Nu = m`, `Nv = n` and the nodes in the grid's
-//! order (`i` fastest), with `z` given per node (e.g. a PDE solution) or 0. The digest notes
-//! that UNAMALLA wrote `m n` with `j` fastest, which Geomview reads transposed when `m ≠ n`;
+//! order (`i` fastest), with `z` given per node (e.g. a PDE solution) or 0. The manual's MESH
+//! files have the header `m n` with `j` fastest, which Geomview reads transposed when `m ≠ n`;
 //! this writer follows Geomview's definition instead.
 
 use std::path::Path;

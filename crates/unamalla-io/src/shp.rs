@@ -33,8 +33,8 @@
 //!
 //! Every size read from the file is checked against the bytes that are really there **before**
 //! anything is allocated, so no input makes the reader reserve more memory than the file's own
-//! size (issue #14: the `shapefile` crate this module used to wrap trusted the counts and was
-//! made to reserve gigabytes by 300-byte inputs). The rules, each reported as
+//! size (the `shapefile` crate this module used to wrap trusted the counts and was made to
+//! reserve gigabytes by 300-byte inputs; see `docs/reliability.md`). The rules, each reported as
 //! [`IoError::MalformedBinary`] with the byte offset of the offending field:
 //!
 //! * the file has the whole 100-byte header, and the declared file length is at least 100

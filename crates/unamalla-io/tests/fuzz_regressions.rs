@@ -1,5 +1,5 @@
-//! Regression tests for inputs found by the fuzz targets of `fuzz/` (issue #14; figures and
-//! commands in `docs/reliability.md`).
+//! Regression tests for inputs found by the fuzz targets of `fuzz/` (figures and commands
+//! in `docs/reliability.md`).
 
 use unamalla_io::{parse_shapefile_parts, IoError};
 
@@ -101,8 +101,8 @@ fn shapefile_padded_null_shape_is_an_error() {
 /// the polygon record at byte 100 declares 212 bytes of content but has 0 parts and 10 points,
 /// i.e. 44 + 16·10 = 204 bytes of data and 8 bytes of padding. The crate read on from the end
 /// of the data (not from the declared end of the record), took the padding and the next bytes
-/// for a record header and reserved gigabytes. Our own parser (since issue #14 the `shapefile`
-/// crate is no longer used) moves by the declared length to byte 100 + 8 + 212 = 320, where
+/// for a record header and reserved gigabytes. Our own parser (the `shapefile` crate is no
+/// longer used) moves by the declared length to byte 100 + 8 + 212 = 320, where
 /// the next record header (8 bytes) does not fit in the 324-byte file.
 #[test]
 fn shapefile_record_padding_is_skipped_by_declared_length() {

@@ -1,6 +1,7 @@
-//! UNAMALLA's own formats (`.con`, XY, RED, Geomview MESH) and plain-text rings: the seed 001
-//! example contours load as regions, hand-written files with known node orders, bit-exact round
-//! trips, typed errors with line numbers, and no panic on truncation.
+//! UNAMALLA's own formats (`.con`, XY, RED, Geomview MESH) and plain-text rings: the example
+//! contours of the Unamalla v2.0 manual [González Flores, §A.5] load as regions, hand-written
+//! files with known node orders, bit-exact round trips, typed errors with line numbers, and no
+//! panic on truncation.
 
 mod common;
 
@@ -32,7 +33,7 @@ fn point_set(v: &[DVec2]) -> Vec<[u64; 2]> {
 }
 
 #[test]
-fn seed_001_hole_contour_loads_as_a_region() {
+fn manual_hole_contour_loads_as_a_region() {
     let c = read_con(data("hole-ibflag13.con")).unwrap();
     assert_eq!(c.ibflag(), Ibflag::Cut13);
     assert_eq!(c.counts(), [2, 7, 2, 5]);
@@ -46,7 +47,8 @@ fn seed_001_hole_contour_loads_as_a_region() {
         pts(&[(0., 0.), (20., -15.), (30., 1.), (12., 15.), (0., 0.)]).as_slice()
     );
     let r = read_region_con(data("hole-ibflag13.con")).unwrap();
-    // Digest §5: area 454 − 48.5 = 405.5 (shoelace, computed independently there).
+    // Area 454 − 48.5 = 405.5: outer quadrilateral minus hexagonal hole, by the shoelace
+    // formula (worked out by hand; the manual does not state it).
     assert_eq!(r.area(), 405.5);
     assert_eq!(r.holes().len(), 1);
     assert!(r.outer().signed_area() > 0.0 && r.holes()[0].signed_area() < 0.0);
@@ -68,12 +70,12 @@ fn seed_001_hole_contour_loads_as_a_region() {
 }
 
 #[test]
-fn seed_001_cuad2pp_contour_loads_as_a_region() {
+fn manual_cuad2pp_contour_loads_as_a_region() {
     let c = read_con(data("cuad2pp.con")).unwrap();
     assert_eq!(c.ibflag(), Ibflag::FourSides);
     assert_eq!(c.counts(), [2, 2, 4, 2]);
     let s = c.sides();
-    // Digest §7.4: B1 = (0.4,0)–(0.6,0), B2 = (0.6,0)–(1,0), B3 = (1,0),(1,1),(0,1),(0,0),
+    // The manual's side split [González Flores, §A.5]: B1 = (0.4,0)–(0.6,0), B2 = (0.6,0)–(1,0), B3 = (1,0),(1,1),(0,1),(0,0),
     // B4 = (0,0)–(0.4,0).
     assert_eq!(s[0], pts(&[(0.4, 0.), (0.6, 0.)]).as_slice());
     assert_eq!(s[1], pts(&[(0.6, 0.), (1., 0.)]).as_slice());
@@ -333,7 +335,7 @@ fn no_panic_on_any_truncation() {
     }
 }
 
-/// The seed 001 hole region written with `ibflag = 24` (sides 2 and 4 are the cut, side 1 the
+/// The manual's hole region [González Flores, §A.5.1] written with `ibflag = 24` (sides 2 and 4 are the cut, side 1 the
 /// outer loop, side 3 the hole) gives the same region.
 #[test]
 fn ibflag_24_contour() {
