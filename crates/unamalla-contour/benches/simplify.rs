@@ -1,4 +1,4 @@
-//! Modified-area simplification of a 100,000-vertex ring (criterion; issue #5, < 100 ms).
+//! Modified-area simplification of a 100,000-vertex ring (criterion; target < 100 ms).
 //!
 //! Timed: one whole `simplify_region` call on an already validated `Region` (removal with the
 //! topology check, building the output region with `Region::from_simple_rings`, Hausdorff

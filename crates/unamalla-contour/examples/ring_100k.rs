@@ -1,5 +1,5 @@
 //! Wall and CPU time of modified-area simplification of the 100,000-vertex benchmark ring
-//! (the ring of `benches/simplify.rs`; issue #5: < 100 ms). Timed: one `simplify_region`
+//! (the ring of `benches/simplify.rs`; target < 100 ms). Timed: one `simplify_region`
 //! call on an already validated `Region` — the topology-safe removal, building the output
 //! region (`Region::from_simple_rings`, O(n) checks) and the metrics (Hausdorff distance, area change); **not**
 //! timed: building and validating the input region. Prints the best and median wall time

@@ -1,4 +1,4 @@
-//! Triangle measures behind every criterion of seed 000 §3.3 (digest §2.4–§2.5).
+//! Triangle measures behind every criterion of [Méndez 2023, §3.3] (§3.3.1–§3.3.4).
 //!
 //! For a vertex `b` with ring neighbours `a` (previous) and `c` (next) the triangle is
 //! `T = (a, b, c)`, with side lengths `ℓ₁ = |b − a|`, `ℓ₂ = |c − b|`, `ℓ₃ = |c − a|`, perimeter
@@ -11,7 +11,7 @@
 //! * in/circumradius ratio (§3.3.2): `r = |α| / p`, `R = ℓ₁ℓ₂ℓ₃ / (2|α|)`, so
 //!   `r / R = 2 α² / (p ℓ₁ ℓ₂ ℓ₃)` ∈ `[0, 1/2]`;
 //! * modified radius metric (3.7): `ρ = 2 r R |sin θ| = (ℓ₁ℓ₂ℓ₃ / p) · |α| / (ℓ₁ℓ₂) = ℓ₃ |α| / p`
-//!   (erratum 6: `|sin θ|`).
+//!   (the thesis writes `sin(v_i)`; with `|sin θ|` the metric is ≥ 0 at reflex vertices too).
 
 use glam::DVec2;
 use unamalla_mesh::geometry::orient2d;

@@ -1,11 +1,11 @@
-//! Minimum-perimeter polygon (MPP) noise reduction, seed 000 §3.2.2, eq. (3.2):
+//! Minimum-perimeter polygon (MPP) noise reduction, [Méndez 2023, §3.2.2, (3.2)]:
 //!
 //! ```text
 //!   min  Σ_i |u_{i+1} − u_i|    subject to  ‖u_i − v_i‖_∞ ≤ h = p₀·δ,  i = 1..n (cyclic)
 //! ```
 //!
 //! where `v_i` are the input vertices and `p₀` the input perimeter. The objective is convex but
-//! **not** smooth (nor quadratic, erratum 4): a norm is not differentiable where an edge has zero
+//! **not** smooth (nor quadratic, as the thesis calls it): a norm is not differentiable where an edge has zero
 //! length, which is exactly where the optimum tends to go when boxes overlap.
 //!
 //! **Solver.** We minimise the smoothed perimeter `f_η(u) = Σ √(|u_{i+1} − u_i|² + η²)` — convex,

@@ -1,4 +1,7 @@
-//! Noise detection, seed 000 §3.2.1 (digest §2.2, erratum 3) plus an automatic jump detector.
+//! Noise detection, [Méndez 2023, §3.2.1, (3.1)], plus an automatic jump detector.
+//!
+//! (The chapter summary speaks of areas scaled by the average area, §3.2.1 of the largest one:
+//! the two differ by a constant shift of the log profile, which moves no jump.)
 //!
 //! The thesis plots the **sorted log-area profile** (3.1)
 //!

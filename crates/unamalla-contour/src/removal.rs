@@ -24,7 +24,8 @@
 //! triangle's bounding box. The point-in-triangle tests use `orient2d` with its floating-point
 //! filter inlined (`criteria::orient2d_fast`, bit-identical to the exact predicate).
 //!
-//! Performance notes (issue #5, 100,000-vertex ring, `docs/benchmarks.md`): the removal loop
+//! Performance notes (target: < 100 ms on the 100,000-vertex ring of `benches/simplify.rs`;
+//! figures in `docs/benchmarks.md`): the removal loop
 //! is memory-bound — each step touches a random place of the ring — so the data structures
 //! are flat arrays indexed by vertex id: the priority queue `Queue` (initial keys sorted once +
 //! `IndexedHeap` of recomputed keys, no stale entries) and the grid (open-addressing table of
@@ -32,7 +33,7 @@
 //! of them reproduce the previous decisions exactly (same order of removals, same topology
 //! answers), which `tests/baseline.rs` checks against the outputs stored before the change.
 //!
-//! Second round (issue #5, measured with `perf record`: the loop's time was mostly cache
+//! Second round (measured with `perf record`: the loop's time was mostly cache
 //! misses, one per separate per-vertex array): everything the loop reads about a vertex —
 //! point, links, grid slot, liveness and a *stamp* counting its neighbour changes — is one
 //! 32-byte `Node`; the stamp also replaces the queue's "updated" flags and the retry
@@ -54,7 +55,7 @@ const DEAD: u32 = u32::MAX;
 /// Everything the removal loop reads about one vertex, in one 32-byte record (two per cache
 /// line): the loop visits vertices in key order, i.e. at random places of the ring, so one
 /// record per vertex costs one cache miss where separate arrays (points, links, liveness, ring,
-/// grid cell) cost one each (issue #5: these misses were most of the topology check's time).
+/// grid cell) cost one each (these misses were most of the topology check's time).
 #[derive(Debug, Clone, Copy)]
 #[repr(C)]
 struct Node {

@@ -20,7 +20,7 @@ use crate::error::ContourError;
 use crate::mpp::{minimum_perimeter_polygon, MppOptions};
 use crate::removal::{batch, sequential, Stop, Workspace};
 
-/// A simplification method of seed 000 ch. 3 (names as accepted by [`Method::from_str`]).
+/// A simplification method of [Méndez 2023, Ch. 3] (names as accepted by [`Method::from_str`]).
 ///
 /// Default thresholds ([`Method::default_epsilon`], [`Method::default_delta`]):
 ///
@@ -416,7 +416,7 @@ pub fn simplify_region(
 /// radius of curvature `R` keeps vertices about `s ≈ (c·h²·R²)^{1/4}` apart (ζ ≈ s⁴/R² for
 /// spacing `s`), so the chord error there is `s²/(8R) ≈ √c·h/8`, a fraction of a cell, while
 /// spikes and zig-zags of width ≲ `√c·h` (ζ ≈ width²) are removed. (Our addition, not in
-/// seed 000; the criterion and its ζ are seed 000 digest §2.5, eq. (3.6).)
+/// the thesis; the criterion and its ζ are [Méndez 2023, (3.4), (3.6)].)
 pub fn remove_features_below(region: &Region, min_area: f64) -> Result<Region, ContourError> {
     let min_area = check_param("min_area", min_area)?;
     let input: Vec<Vec<DVec2>> = region.rings().map(|r| r.points().to_vec()).collect();
@@ -434,7 +434,7 @@ pub fn remove_features_below(region: &Region, min_area: f64) -> Result<Region, C
 /// `removal::Workspace` (which keeps each ring simple, all rings disjoint, every hole inside
 /// the outer ring and the orientation; see its module documentation) or an MPP step whose
 /// result `mpp_step` validated with [`Region::new`]. So the O(n log n) re-validation of
-/// [`Region::new`] (R*-tree over all edges, ≈ 8 % of the 100k benchmark, issue #5) is skipped:
+/// [`Region::new`] (R*-tree over all edges, ≈ 8 % of the 100k benchmark) is skipped:
 /// [`Region::from_simple_rings`] runs only the O(n) checks (finite, no repeated points, ≥ 3
 /// points, non-zero area) and normalises the orientation the same way, so the result equals
 /// `Region::new` on the same rings — which debug builds (every test) assert.
@@ -652,7 +652,7 @@ pub struct SubsetHausdorff {
 /// The chain bound can exceed `H` when a removed vertex is nearer to *another* output edge
 /// than to its own (a spike pointing at another part of the boundary); then the certificate
 /// fails and the sampled [`hausdorff`] (vertices and edge midpoints against exact segments,
-/// R*-tree) is returned with `exact = false`. This is the "per-edge chain" approach of issue #5;
+/// R*-tree) is returned with `exact = false`. This is the "per-edge chain" approach;
 /// the bound `D` itself is the classical simplification error of Douglas–Peucker-type methods.
 ///
 /// ```

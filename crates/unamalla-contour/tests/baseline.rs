@@ -1,6 +1,6 @@
-//! Regression guard for issue #5 (speed work on the removal loop, the topology check, the final
-//! validation and the Hausdorff distance): every method must return **exactly** the same
-//! vertices as the implementation before that work, and the same metrics.
+//! Regression guard for the speed work on the contour stage (the removal loop, the topology
+//! check, the final validation and the Hausdorff distance): every method must return
+//! **exactly** the same vertices as the implementation before that work, and the same metrics.
 //!
 //! `tests/data/baseline_outputs.txt` was written by this test (`UNAMALLA_CONTOUR_BLESS=1`) with
 //! the code as it was before the speed work (lazy `BinaryHeap`, hashed bucket grid, R*-tree
