@@ -1,6 +1,6 @@
-//! Example 5.1 of the thesis (seed 000 §5.2, Fig 5.1): 3 blocks, 2 cuts, 17 curves.
+//! Example 5.1 of the thesis ([Méndez 2023, §5.2.2], Fig 5.1): 3 blocks, 2 cuts, 17 curves.
 //!
-//! Assembles `A m = b`, prints the equations next to the ones printed in the thesis (digest §4.4), solves
+//! Assembles `A m = b`, prints the equations next to the ones printed in the thesis, solves
 //! problem (5.10) with density d = 1 and prints `m1 .. m17`, the objective and the block sizes `M_k × N_k`.
 //! Finally shows the error for a deliberately infeasible variant (pinned `m9 = 4`).
 //!

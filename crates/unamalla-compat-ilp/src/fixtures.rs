@@ -3,8 +3,9 @@
 
 use crate::problem::{Block, CompatProblem, Curve, CutPair};
 
-/// The Fig 5.1 / Example 5.1 topology of seed 000 (3 blocks, 2 cuts, 17 curves), with curve ids 1..17 and
-/// the block-3 numbering printed in the thesis (erratum 13): bottom `Q14`, right `Q13`, top `Q16, Q17`,
+/// The Fig 5.1 / Example 5.1 topology of [Méndez 2023, §5.2.2] (3 blocks, 2 cuts, 17 curves), with curve
+/// ids 1..17 and the block-3 numbering printed in the example, which does not follow the b, r, t, l order
+/// of the thesis's index sets `J_{k,side}` (§5.2.1): bottom `Q14`, right `Q13`, top `Q16, Q17`,
 /// left `Q15`. Cut 1 is `(ι, ς) = (Q11, Q2)`, cut 2 is `(Q17, Q7)`, so the cut rows read `m11 − m2 = 0` and
 /// `m17 − m7 = 0` (the thesis prints them negated).
 ///

@@ -1,4 +1,4 @@
-//! Interval assignment ILP (3) of seed 002 (digest §5), after Mitchell's "high fidelity interval
+//! Interval assignment ILP [Ruiz-Gironés & Sarrate, (3)], after Mitchell's "high fidelity interval
 //! assignment":
 //!
 //! ```text
@@ -16,7 +16,8 @@ use crate::lp::{
 };
 use crate::problem::{tolerant_ceil, MAX_COUNT};
 
-/// Direction of an edge in computational space (seed 002 digest §4).
+/// Direction of an edge in computational space (the edge classification of [Ruiz-Gironés & Sarrate,
+/// Fig 4]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Direction {
     /// `+i`: horizontal, left to right.
@@ -40,7 +41,8 @@ impl Direction {
         }
     }
 
-    /// Edge labels of a loop from integer vertex labels (digest §4, compact form): the first edge is `+i`
+    /// Edge labels of a loop from integer vertex labels (the paper's edge classification rule in compact
+    /// form): the first edge is `+i`
     /// and `d_{k+1} = d_k + α_{v_k} (mod 4)`, where `labels[k]` is the label of the vertex **between**
     /// edge `k` and edge `k+1`. Returns the labels and whether the loop closes (`Σ α ≡ 0 mod 4`).
     pub fn propagate(labels: &[i8]) -> (Vec<Direction>, bool) {
@@ -137,7 +139,7 @@ pub struct IntervalSolution {
     pub verification: IntervalVerification,
 }
 
-/// Solve the interval assignment ILP (3) (seed 002 §5) and verify the answer; on a failed check, fall back
+/// Solve the interval assignment ILP [Ruiz-Gironés & Sarrate, (3)] and verify the answer; on a failed check, fall back
 /// to the LP relaxation rounded up and repaired on untwinned edges.
 pub fn assign_intervals(
     problem: &IntervalProblem,

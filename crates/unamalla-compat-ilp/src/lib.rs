@@ -1,13 +1,14 @@
 //! # unamalla-compat-ilp — compatible point counts and the integer programs of the pipeline
 //!
-//! Stage 3b of the unamalla pipeline (seed 000, thesis ch. 5.2; seed 002 §§2–3): given a decomposition of
-//! the region into blocks, each with four sides (bottom, right, top, left) made of boundary curves `Q_j`
+//! Stage 3b of the unamalla pipeline ([Méndez 2023, §5.2]; [Ruiz-Gironés & Sarrate, (3), (6), (8)]; the
+//! references are listed in `docs/references.md` of the repository): given a decomposition of the region
+//! into blocks, each with four sides (bottom, right, top, left) made of boundary curves `Q_j`
 //! (pieces of `∂Ω` or one of the two copies of a cut), choose the number of points `m_j` on every curve so
 //! that opposite sides of each block carry the same number of points and both copies of a cut agree.
 //!
 //! ## Formulas implemented
 //!
-//! *Compatibility equations* (seed 000 digest §4.3, eqs. (5.1)–(5.4)), `s_{k,side}` = number of curves on a
+//! *Compatibility equations* ([Méndez 2023, §5.2.1, (5.1)–(5.4)]), `s_{k,side}` = number of curves on a
 //! side, junction points counted once:
 //!
 //! ```text
@@ -20,7 +21,8 @@
 //! *Block sizes* (5.5)/(5.6): `M_k = Σ_{J_{k,b}} m_j − s_{k,b} + 1`, `N_k = Σ_{J_{k,r}} m_j − s_{k,r} + 1`
 //! ([`block_sizes`]).
 //!
-//! *Integer program* (5.10) with the ceiling of erratum 7 and `m_j ≥ 2` ([`solve()`]):
+//! *Integer program* (5.10) with the ceiling of (5.8)/(5.9) (the thesis prints a floor in (5.10)/(5.11);
+//! the ceiling is its stated intent) and `m_j ≥ 2`, as a curve has two end points ([`solve()`]):
 //!
 //! ```text
 //! min Σ_j m_j   s.t.   A m = b,   m_j ≥ L_j,   m_j ∈ Z,
@@ -38,9 +40,10 @@
 //! with a reduced-cost optimality certificate ([`Optimality::FitCertified`]), or as a MILP when the
 //! system is not a network.
 //!
-//! *Interval assignment* ILP (3) of seed 002 (digest §5), `min Σ_e n_e/l(e) + M`, `M ≥ n_e/N_e`
-//! ([`assign_intervals`]), and *vertex classification* ILPs (6)/(8) (digest §7–8, Option A reading,
-//! `−2 ≤ α_i ≤ 1`, `Σ α_i = 4(1 − H)`) ([`classify_vertices`]).
+//! *Interval assignment* ILP [Ruiz-Gironés & Sarrate, (3)], `min Σ_e n_e/l(e) + M`, `M ≥ n_e/N_e`
+//! ([`assign_intervals`]), and *vertex classification* ILPs [Ruiz-Gironés & Sarrate, (6), (8)], with the
+//! measured angles as the `ā_i` (see [`vertex`]), `−2 ≤ α_i ≤ 1`, `Σ α_i = 4(1 − H)`
+//! ([`classify_vertices`]).
 //!
 //! ## Solvers and verification
 //!
@@ -52,7 +55,8 @@
 //! For (5.10) the crate also has an exact combinatorial path ([`Method::NetworkFlow`]). After merging the
 //! two copies of each cut and substituting `x = m − L` (the shift of (5.11)), every column has at most two
 //! non-zeros. When the block rows can be re-signed so that each such column has one `+1` and one `−1` (the
-//! orientation condition behind Prop. 5.2 / Hoffman–Kruskal; erratum 8 notes that it can fail), the
+//! orientation condition behind Prop. 5.2 / Hoffman–Kruskal, which the thesis assumes for all cuts at
+//! once; it can fail, e.g. around holes), the
 //! problem is an uncapacitated min-cost transshipment with positive costs, solved by successive shortest
 //! paths. Its node potentials give an integral LP dual `y`; checking `(Aᵀy)_j ≤ 1` and equality of the
 //! dual and primal objectives **certifies optimality** of whatever path produced the counts
@@ -84,7 +88,8 @@
 //!
 //! ## Infeasibility
 //!
-//! Equalities plus lower bounds can be infeasible (erratum 8; e.g. with pins or degenerate corner choices).
+//! Equalities plus lower bounds can be infeasible, e.g. with pins or degenerate corner choices (the thesis's
+//! total-unimodularity argument gives integral vertices, not a non-empty feasible set).
 //! [`solve()`] then returns [`CompatError::Infeasible`] whose [`InfeasibilityReport`] names a small set of
 //! conflicting constraint groups — side equations (block id, sides, curve ids), cut equations, pins — found
 //! by a deletion filter, so that removing any one of them makes the rest feasible.
@@ -93,7 +98,8 @@
 //!
 //! Curves are referenced by 0-based **index** into [`CompatProblem::curves`]; each curve has a user-facing
 //! `id` used in messages and printed equations (`m{id}`). [`CompatProblem::from_index_sets`] builds the
-//! thesis numbering `J_{k,side}` (erratum 13: that convention is authoritative).
+//! thesis numbering `J_{k,side}` of §5.2.1 (curves block by block, sides in the order b, r, t, l; the thesis's
+//! Example 5.1 numbers block 3 differently, see [`fixtures::thesis_example_5_1`]).
 // No unwrap/expect in library code: user input must give an error, never a panic (see
 // docs/reliability.md). Tests may use them; a local `#[allow]` needs a comment naming the invariant.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]

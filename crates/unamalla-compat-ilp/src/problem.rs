@@ -1,5 +1,5 @@
 //! Input description of a decomposition: curves `Q_j`, blocks with four sides, cut pairs
-//! (seed 000 digest §4.1 and §4.3).
+//! ([Méndez 2023, §5.1, §5.2.1]).
 
 use std::collections::HashMap;
 use std::fmt;
@@ -161,7 +161,7 @@ impl CutPair {
 }
 
 /// The input of the compatibility stage: the curves `Q_1..Q_p`, the blocks `Ω_1..Ω_n` and the cuts
-/// `(ι_i, ς_i)`, `i = 1..q` (seed 000 digest §4.3).
+/// `(ι_i, ς_i)`, `i = 1..q` ([Méndez 2023, §5.2.1]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CompatProblem {
     /// The curves `Q_j`.
@@ -185,7 +185,7 @@ impl CompatProblem {
         }
     }
 
-    /// Build a problem with the thesis' index-set convention `J_{k,side}` (seed 000 digest §4.3):
+    /// Build a problem with the thesis' index-set convention `J_{k,side}` ([Méndez 2023, §5.2.1]):
     /// curves are numbered consecutively block by block and, inside a block, side by side in the order
     /// b, r, t, l. `side_counts[k] = [s_{k,b}, s_{k,r}, s_{k,t}, s_{k,l}]`; `lengths[j]` is the length of the
     /// curve with 0-based index `j` (id `j + 1`); `cuts` are pairs of 0-based curve indices. Block ids are
@@ -355,7 +355,7 @@ impl CompatProblem {
 /// How the lower bounds `m_j ≥ L_j` of problem (5.10) are derived from the curve lengths.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum LowerBounds {
-    /// Density mode (eq. (5.9), with the ceiling of erratum 7): `L_j = max(2, d·⌈ℓ_j/ℓ_min⌉)`, `d ≥ 1`.
+    /// Density mode (eq. (5.9), with its ceiling; (5.10) prints a floor): `L_j = max(2, d·⌈ℓ_j/ℓ_min⌉)`, `d ≥ 1`.
     Density(usize),
     /// Target cell size `h > 0`: at least `⌈ℓ_j/h⌉` segments, i.e. `L_j = max(2, ⌈ℓ_j/h⌉ + 1)` points,
     /// so no cell along the curve is longer than `h`.

@@ -177,7 +177,7 @@ impl<'a> Prepared<'a> {
     }
 }
 
-/// Solve problem (5.10) (seed 000 §5.2.2): `min Σ_j m_j` s.t. `A m = b`, `m_j ≥ L_j` (density or cell
+/// Solve problem (5.10) ([Méndez 2023, §5.2.2]): `min Σ_j m_j` s.t. `A m = b`, `m_j ≥ L_j` (density or cell
 /// size, at least 2) and `m_j = pin_j` for pinned curves. The returned counts are verified independently;
 /// failed or unverifiable paths fall back to the others (recorded in [`CompatSolution::rejected`]).
 ///

@@ -1,4 +1,4 @@
-//! The compatibility system `A m = b` (seed 000 digest §4.3, eqs. (5.1)–(5.4)) and the block sizes
+//! The compatibility system `A m = b` ([Méndez 2023, §5.2.1, (5.1)–(5.4)]) and the block sizes
 //! (5.5)/(5.6).
 
 use std::fmt;

@@ -1,5 +1,7 @@
-//! Vertex classification ILPs (6) and (8) of seed 002 (digest §7, §8.4), in the digest's **Option A**
-//! reading: `ā_i = θ_i/(π/2)` is the real measured value, and
+//! Vertex classification ILPs [Ruiz-Gironés & Sarrate, (6), (8)]. The paper calls `ā_i` "the initially
+//! detected classification" without saying whether it is the rounded label or the measured angle, and
+//! gives no values for the weights; we take the **measured value** `ā_i = θ_i/(π/2)` and by default `ρ_i = ω_i = 1`,
+//! so the cost is the angular deviation, and make the type bounds explicit:
 //!
 //! ```text
 //! min  Σ_i ρ_i D_i + ω_i d_i
@@ -20,7 +22,8 @@ use crate::lp::{
     round_integral, LinearProgram, LpOutcome, MilpBackend, Sense, VarDef, MILP_TIME_LIMIT,
 };
 
-/// Vertex type of seed 002 §3.1, by integer label.
+/// Vertex type of the submapping vertex classification ([Ruiz-Gironés & Sarrate, Fig 3]), by integer
+/// label.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum VertexKind {
     /// Reversal (Reverso), label −2.
@@ -119,8 +122,8 @@ pub fn classify_vertices(
 
 /// The same program with an explicit right-hand side `Σ_i α_i = target` (`options.holes` is ignored).
 ///
-/// This is the **per-loop** variant of (8) the seed 002 digest §8.4 \[NOTE\] offers next to the paper's
-/// global sum: the outer loop alone gets `target = 4` (program (6)) and each hole loop alone gets
+/// This is a **per-loop** variant of (8), our option next to the paper's global sum (the paper constrains
+/// only the sum over all loops): the outer loop alone gets `target = 4` (program (6)) and each hole loop alone gets
 /// `target = −4` (its straight-edge turning sum with the domain on the left is `−2π`).
 ///
 /// ```

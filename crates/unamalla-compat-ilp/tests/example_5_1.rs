@@ -1,6 +1,6 @@
-//! Example 5.1 of the thesis (seed 000 digest §4.4): equations, d = 1 solution, block sizes, and
-//! hand-derived variants (d = 2, cell size, pins). Expected values come from the digest or are derived by
-//! hand in the comments, never from this crate's output.
+//! Example 5.1 of the thesis [Méndez 2023, §5.2.2]: equations, d = 1 solution, block sizes, and
+//! hand-derived variants (d = 2, cell size, pins). Expected values come from the thesis or are derived
+//! by hand in the comments (the block sizes by (5.5)/(5.6)), never from this crate's output.
 
 use std::collections::BTreeMap;
 
@@ -9,7 +9,7 @@ use unamalla_compat_ilp::{
     block_sizes, solve, CompatSystem, LowerBounds, Method, Optimality, SolveOptions, SolverPath,
 };
 
-/// The thesis' d = 1 counts m1..m17 (digest §4.4).
+/// The thesis' d = 1 counts m1..m17 ([Méndez 2023, Example 5.1]).
 const THESIS_M: [usize; 17] = [6, 6, 6, 6, 8, 6, 6, 6, 8, 8, 6, 4, 8, 8, 8, 3, 6];
 
 /// The 8 printed equations as (curve id → coefficient, rhs).

@@ -1,6 +1,7 @@
 //! Non-network systems, independent verification of given counts, the interval assignment ILP (3) and
 //! the vertex classification ILPs (6)/(8). Expected values are derived by hand in the comments (the
-//! geometries are the synthetic suite of the seed 002 digest §9.2).
+//! geometries T1–T10 are synthetic stand-ins for the figures of [Ruiz-Gironés & Sarrate], which give no
+//! coordinates).
 
 use unamalla_compat_ilp::fixtures::thesis_example_5_1;
 use unamalla_compat_ilp::{
