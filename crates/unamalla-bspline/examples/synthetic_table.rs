@@ -1,7 +1,7 @@
-//! The S1–S5 table of `docs/results.md` (seed 003 digest §8): for each synthetic region and
-//! net size 18×18, 30×30, 35×35, the interior control points are optimized (`½S_{ω,ε} + ½F_AO`,
-//! defaults of `InteriorOptions`), the biquadratic map is built and certified, and `det J` is
-//! sampled on an `N × N` grid.
+//! The S1–S5 table of `docs/results.md` (the regions of `unamalla_bspline::synthetic`): for each
+//! synthetic region and net size 18×18, 30×30, 35×35, the interior control points are optimized
+//! (`½S_{ω,ε} + ½F_AO`, defaults of `InteriorOptions`), the biquadratic map is built and certified,
+//! and `det J` is sampled on an `N × N` grid.
 //!
 //! ```sh
 //! cargo run --release -p unamalla-bspline --example synthetic_table -- [N] [sizes...]

@@ -1,9 +1,10 @@
-//! Injectivity certificates (seed 003 digest §2.5, §3.6).
+//! Injectivity certificates ([Abelló et al., Theorem 1, Theorem 2, Observation 3]).
 //!
 //! * [`theorem1`]: a **convex** control net (every cell's four diagonal triangles have positive
 //!   doubled area, Definition 1) makes the **bilinear** map injective: on each cell `det J` is a
 //!   bilinear B-spline whose four coefficients are `(n−1)(m−1)` times those doubled areas
-//!   (Prop 1 corrected, erratum 3; labels per erratum 4).
+//!   (Prop 1 with the factor multiplying, not dividing as printed in (14); the proof's labels
+//!   `t¹` and `t³` are swapped, which changes nothing as all four must be positive).
 //! * [`theorem2`]: the biquadratic map is injective if all **36 determinants**
 //!   `det[h_{r',s} | v_{r,s'}]` (`r ∈ {i,i+1,i+2}`, `r' ∈ {i,i+1}`, `s ∈ {j,j+1,j+2}`,
 //!   `s' ∈ {j,j+1}`) of every patch `U_{ij}` are positive (41). Since the basis products of (39)
@@ -11,7 +12,8 @@
 //!   certified lower bound. Of the 36 pairs, the 16 with `r ∈ {r', r'+1}` and
 //!   `s ∈ {s', s'+1}` are diagonal-triangle areas of the four control quads (Observation 1);
 //!   failures are counted separately for those "geometric" pairs and the 20 others.
-//! * [`bernstein_test`]: Observation 3 as developed in the digest (§3.6 recipe): `det J` on a
+//! * [`bernstein_test`]: Observation 3, which the paper proposes but does not develop, worked
+//!   out here: `det J` on a
 //!   patch is `Σ c_ab B_a(u) B_b(v)` ([`crate::map`]); if all `c_ab > 0` then `det J > 0` on
 //!   the patch (and `min c_ab` is a lower bound). Otherwise the patch is split in four by de
 //!   Casteljau at `u = v = ½` (the coefficients of each half are again Bernstein coefficients
@@ -19,8 +21,8 @@
 //!   corner coefficient `≤ 0` **refutes** positivity with a witness point.
 //!
 //! With `det J > 0` on all of `U` and `x|∂U` a bijection onto the simple closed curve `∂Ω` the
-//! map is a bijection `U → Ω` (digest §1, degree argument; erratum 15: the paper's convex-hull
-//! argument does not cover the biquadratic case).
+//! map is a bijection `U → Ω` (a standard degree argument; the paper's convex-hull argument of
+//! §1.1 does not cover the biquadratic case, whose neighbouring patches have overlapping hulls).
 
 use crate::map::{Degree, TensorMap};
 use crate::net::ControlNet;
@@ -43,7 +45,7 @@ pub struct Theorem1Report {
     pub det_j_lower_bound: Option<f64>,
 }
 
-/// Theorem 1 (digest §2.5): convex net ⇒ injective bilinear map.
+/// Theorem 1 ([Abelló et al., §1.2]): convex net ⇒ injective bilinear map.
 pub fn theorem1(net: &ControlNet) -> Theorem1Report {
     let c = net.convexity();
     let holds = c.convex();
@@ -99,7 +101,7 @@ pub struct Theorem2Report {
     pub det_j_lower_bound: Option<f64>,
 }
 
-/// Theorem 2 (digest §3.6): the 36 determinants of every biquadratic patch. Needs
+/// Theorem 2 ([Abelló et al., §1.3, (41)]): the 36 determinants of every biquadratic patch. Needs
 /// `n, m ≥ 3`; returns `None` for smaller nets.
 pub fn theorem2(net: &ControlNet) -> Option<Theorem2Report> {
     let (n, m) = (net.n(), net.m());

@@ -1,4 +1,4 @@
-//! Planar B-spline curves `x(t) = Σ_i P_i B^k_i(t)` (seed 003 digest §4 (42)–(43), checklist 3).
+//! Planar B-spline curves `x(t) = Σ_i P_i B^k_i(t)` ([Abelló et al., §2.1, (42)–(43)]).
 //!
 //! The derivative is again a B-spline curve, of order `k − 1` on the knots without the first and
 //! last one, with control points `Q_r = (k−1)(P_{r+1} − P_r)/(t_{r+k} − t_{r+1})` (0-based;

@@ -38,7 +38,7 @@ pub enum BsplineError {
     /// Two boundary curves do not meet at a corner.
     #[error("corner {corner}: the {a} and {b} curves do not meet (distance {distance:e})")]
     CornerMismatch {
-        /// `Q`, `R`, `S` or `T` (seed 003 digest §4).
+        /// `Q`, `R`, `S` or `T` ([Abelló et al., §2.1]).
         corner: char,
         /// First curve.
         a: &'static str,
@@ -57,7 +57,7 @@ pub enum BsplineError {
     #[error("the boundary control polygon is not simple: {0}")]
     NotSimple(String),
     /// A corner is not a strictly convex vertex of the boundary control polygon, so no convex
-    /// control net exists (seed 003 digest §4, validation).
+    /// control net exists (a corner belongs to a single cell of the net).
     #[error("corner {corner} is not a strictly convex vertex of the boundary control polygon (turn {turn:e}); no convex control net exists")]
     ReflexCorner {
         /// `Q`, `R`, `S` or `T`.

@@ -1,6 +1,5 @@
-//! Output of maps (seed 003 digest §6 step 7, checklist 22): isoparametric curves (lines of
-//! constant ξ and constant η, as in the bottom panels of the paper's Figs 8–11), the control
-//! net and the Jacobian field.
+//! Output of maps: isoparametric curves (lines of constant ξ and constant η, as in the bottom
+//! panels of the paper's Figs 8–11), the control net and the Jacobian field.
 //!
 //! This module formats; it does not touch the file system. Every writer takes a
 //! `&mut dyn Write`, so callers pass the writer of `unamalla_io::atomic_write` (as the CLI and

@@ -1,5 +1,5 @@
 //! Interior control points: a convex structured mesh on the boundary control polygon `Ω'`
-//! (seed 003 digest §5, algorithm §6 steps 3–5).
+//! ([Abelló et al., §2.2]).
 //!
 //! The interior points `P_{i,j}` (`2 ≤ i ≤ n−1`, `2 ≤ j ≤ m−1`, 1-based) are the free vertices of
 //! an `n × m` structured mesh whose boundary vertices are the fixed boundary control points. They
@@ -9,24 +9,24 @@
 //! `S_{ω,ε} = Σ_q f(ω(α_q/ᾱ − ε))` and `f(t) = 1/t` (`t ≥ 1`), `(t−1)(t−2)+1` (`t < 1`) (55)–(56),
 //! `F_AO = Σ_q ½(α_q² + o_q²)` over the `4(n−1)(m−1)` corner triangles.
 //!
-//! Readings (digest §5.3 notes, erratum 13): the argument of `f` is the scale-invariant
-//! `ω(α/ᾱ − ε)` (the printed `ωα − εᾱ` does not fit the "ω large ⇒ ε-convex" claim), and
-//! `F_AO` is divided by `ᾱ²`, which is the paper's functional in coordinates scaled so that
-//! `ᾱ = 1` (the digest's advice before mixing the dimensionless `S` with `F_AO`, which has units
-//! of length⁴). `ᾱ` is constant (fixed by the boundary), so the scaling does not move the
-//! minimizer in any other way. The whole sum is divided by the number of triangles, which only
-//! conditions the numbers.
+//! Readings: the argument of `f` is the scale-invariant `ω(α/ᾱ − ε)` (the printed (55), `ωα − εᾱ`,
+//! lowers the threshold as ω grows, which does not fit the "ω large ⇒ ε-convex" claim;
+//! [Méndez 2023, §6.4.2] writes `φ(ω(α_q − ε))`), and `F_AO` is divided by `ᾱ²`, which is the
+//! paper's functional in coordinates scaled so that `ᾱ = 1` (so that the dimensionless `S` is not
+//! swamped by `F_AO`, which has units of length⁴). `ᾱ` is constant (fixed by the boundary), so the
+//! scaling does not move the minimizer in any other way. The whole sum is divided by the number of
+//! triangles, which only conditions the numbers.
 //!
 //! Expressed with `unamalla-functionals`:
 //! `Scaled{1/N, Sum::convex(½, SOmegaEps(ω, ε, ᾱ, ScaleInvariant), Scaled{1/ᾱ², AreaOrthogonality})}`
-//! on the mesh's `QuadTopology`, minimized by `unamalla-optim` (truncated Newton with trust
-//! region by default — the paper used TN or L-BFGS-B) from the TFI start, which may be folded
-//! (`f` is finite for `α ≤ 0`). The optimizer's safeguard keeps a convex iterate convex.
+//! on the mesh's `QuadTopology`, minimized by `unamalla-optim` (truncated Newton with trust region
+//! by default — the paper used TN or L-BFGS-B) from the TFI start, which may be folded (`f` is
+//! finite for `α ≤ 0`). The optimizer's safeguard keeps a convex iterate convex.
 //!
-//! The paper does not report ω and ε. Defaults here: `ε = 0.05`, `ω = 20` (inside the digest's
-//! suggested ranges). If the result is not ε-convex, ω is doubled and the minimization resumed
-//! from the current mesh ("ω large enough" of the existence theorem), up to
-//! [`InteriorOptions::omega_doublings`] times. The result is checked with Definition 2.
+//! The paper does not report ω and ε. Defaults here (our choice): `ε = 0.05`, `ω = 20`. If the
+//! result is not ε-convex, ω is doubled and the minimization resumed from the current mesh ("ω
+//! large enough" of the existence theorem), up to [`InteriorOptions::omega_doublings`] times. The
+//! result is checked with Definition 2.
 
 use std::sync::Arc;
 use std::time::Instant;

@@ -1,25 +1,28 @@
 //! Knot vectors and the B-spline basis: Cox–de Boor recursion and derivatives.
 //!
-//! Indices here are **0-based**; the paper's (seed 003) are 1-based, so the paper's `B^k_i`
+//! Indices here are **0-based**; the paper's ([Abelló et al.]) are 1-based, so the paper's `B^k_i`
 //! is [`KnotVector::basis`]`(i − 1, t)` and its knot `t_i` is `knots()[i − 1]`.
 //!
 //! * **Clamped uniform knots** ([`KnotVector::clamped_uniform`]): for order `k` (degree
 //!   `k − 1`) and `n ≥ k` basis functions, `k` knots at 0, the `n − k` interior breakpoints
 //!   `l/(n − k + 1)`, `k` knots at 1 (`n + k` knots). Order 2 gives the bilinear knots (4)/(5)
 //!   `{0, ξ_1, …, ξ_n, 1}` with `ξ_i = (i−1)/(n−1)` (ends doubled); order 3 the biquadratic knots
-//!   (23)/(24) `{0, 0, ξ_1, …, ξ_{n−1}, 1, 1}` with `ξ_i = (i−1)/(n−2)` (ends tripled) — seed 003
-//!   digest §2.1 and §3.1.
-//! * **Cox–de Boor** (digest §1): `B^1_i(t) = 1` if `t_i ≤ t < t_{i+1}` (at the right end of the
+//!   (23)/(24) `{0, 0, ξ_1, …, ξ_{n−1}, 1, 1}` with `ξ_i = (i−1)/(n−2)` (ends tripled) —
+//!   [Abelló et al., §1.2, §1.3].
+//! * **Cox–de Boor** ([Piegl & Tiller 1997, Ch. 2]; the paper cites de Boor without formulas):
+//!   `B^1_i(t) = 1` if `t_i ≤ t < t_{i+1}` (at the right end of the
 //!   domain the last non-empty interval is used), and
 //!   `B^k_i = (t − t_i)/(t_{i+k−1} − t_i)·B^{k−1}_i + (t_{i+k} − t)/(t_{i+k} − t_{i+1})·B^{k−1}_{i+1}`
 //!   with `0/0 := 0` ([`KnotVector::basis_of_order`], the literal recursion, and
 //!   [`KnotVector::nonzero_basis`], de Boor's triangular scheme for the `k` non-zero values).
 //! * **Derivatives**, eq. (33) for general order:
 //!   `dB^k_i/dt = (k−1)·(B^{k−1}_i/(t_{i+k−1} − t_i) − B^{k−1}_{i+1}/(t_{i+k} − t_{i+1}))`, where
-//!   the `B^{k−1}` are the lower-order B-splines **on the same knot sequence** (digest §3.3 note).
-//!   The uniform special case (34) is wrong for `n = 3` (digest erratum 6); (33) is always used.
+//!   the `B^{k−1}` are the lower-order B-splines **on the same knot sequence**
+//!   (not the basis of the bilinear map). The uniform special case (34) holds only for `n ≥ 4`
+//!   (for `n = 3`, a single interval, it is wrong); (33) is always used.
 //! * **Greville abscissae** `g_i = (t_{i+1} + … + t_{i+k−1})/(k−1)`: a curve with control points
-//!   `P_i = g_i` reproduces the identity (digest §8, S1 check (i)).
+//!   `P_i = g_i` reproduces the identity (S1 check (i) of
+//!   [`crate::synthetic`]).
 
 use crate::error::BsplineError;
 
@@ -74,7 +77,7 @@ impl KnotVector {
     }
 
     /// Clamped uniform knots on `[0, 1]` for `n ≥ order` basis functions of order `order ≥ 1`
-    /// (see the module docs; order 2 is (4)/(5), order 3 is (23)/(24) of seed 003).
+    /// (see the module docs; order 2 is (4)/(5), order 3 is (23)/(24) of [Abelló et al.]).
     pub fn clamped_uniform(order: usize, n: usize) -> Result<Self, BsplineError> {
         if order == 0 || order > MAX_ORDER {
             return Err(BsplineError::Order {
@@ -212,7 +215,7 @@ impl KnotVector {
         self.basis_of_order(i, self.order, t)
     }
 
-    /// Derivative `dB^k_i/dt` by eq. (33) of seed 003 generalised to order `k`:
+    /// Derivative `dB^k_i/dt` by eq. (33) of [Abelló et al.] generalised to order `k`:
     /// `(k−1)(B^{k−1}_i/(t_{i+k−1} − t_i) − B^{k−1}_{i+1}/(t_{i+k} − t_{i+1}))`, `0/0 := 0`.
     pub fn basis_derivative(&self, i: usize, t: f64) -> f64 {
         let k = self.order;

@@ -1,24 +1,25 @@
 //! # unamalla-bspline
 //!
 //! B-spline tensor-product parametrizations `x: [0,1]² → Ω` of planar regions with irregular
-//! boundary, built from convex control nets, with injectivity certificates — seed 003
+//! boundary, built from convex control nets, with injectivity certificates, after [Abelló et al.]
 //! (Abelló, Hernández, Barrera, González, "Parametrización B-spline de regiones planas con
-//! frontera irregular"), read through its digest `shared/spec/003-digest.md`, whose corrected
-//! formulas are used throughout (each module says which erratum it follows).
+//! frontera irregular"; the references are listed in `docs/references.md` of the repository).
+//! Several printed formulas of the paper have typos (indices, one inverted factor); the
+//! corrected forms are used throughout and each module says which correction it applies.
 //!
-//! | module | what | digest |
+//! | module | what | paper |
 //! |---|---|---|
-//! | [`knots`] | clamped uniform knots (4)/(5), (23)/(24), any order; Cox–de Boor; derivatives (33); Greville abscissae | §1, §2.1, §3.1, §3.3 |
-//! | [`curve`] | B-spline curves and their derivative curves | §4 (42)–(43) |
-//! | [`net`] | control nets, edge vectors (15)/(16), convexity (Defs 1–2), boundary curves and Lemma 4 assembly with validation | §2.3–2.4, §4, §5.3 |
-//! | [`map`] | bilinear/biquadratic tensor maps, per-patch Bézier evaluation, partials, `det J` (Bernstein and power form) and the corrected closed forms Prop 1 / Prop 2 (39) | §2–§3 |
-//! | [`interior`] | interior control points minimizing `½S_{ω,ε} + ½F_AO` with `unamalla-functionals` / `unamalla-optim` from a TFI start | §5 |
-//! | [`certify`] | Theorem 1, Theorem 2 (36 determinants per patch), Bernstein test with subdivision | §2.5, §3.6 |
-//! | [`sample`] | dense parallel `det J` sampler (min/max and where) | §7 |
-//! | [`export`] | isoparametric curves (SVG, VTK), control net and Jacobian field (VTK) | §6 step 7 |
-//! | [`synthetic`] | the synthetic regions S1–S5 | §8 |
+//! | [`knots`] | clamped uniform knots (4)/(5), (23)/(24), any order; Cox–de Boor; derivatives (33); Greville abscissae | §1.1–§1.3 |
+//! | [`curve`] | B-spline curves and their derivative curves | §2.1, (42)–(43) |
+//! | [`net`] | control nets, edge vectors (15)/(16), convexity (Defs 1–2), boundary curves and Lemma 4 assembly with validation | §1.2, §2.1, §2.2 |
+//! | [`map`] | bilinear/biquadratic tensor maps, per-patch Bézier evaluation, partials, `det J` (Bernstein and power form) and the corrected closed forms Prop 1 / Prop 2 (39) | §1.2–§1.3 |
+//! | [`interior`] | interior control points minimizing `½S_{ω,ε} + ½F_AO` with `unamalla-functionals` / `unamalla-optim` from a TFI start | §2.2 |
+//! | [`certify`] | Theorem 1, Theorem 2 (36 determinants per patch), Bernstein test with subdivision | §1.2–§1.3, Observation 3 |
+//! | [`sample`] | dense parallel `det J` sampler (min/max and where) | §3, Table 1 |
+//! | [`export`] | isoparametric curves (SVG, VTK), control net and Jacobian field (VTK) | §3, Figs 8–11 |
+//! | [`synthetic`] | the synthetic regions S1–S5 (ours: the paper's regions have no coordinates) | – |
 //!
-//! The whole method of digest §6 is [`parametrize`]: validate the four boundary control
+//! The whole method (the paper's §2) is [`parametrize`]: validate the four boundary control
 //! polygons, assemble the boundary of the net (Lemma 4), start the interior by TFI, optimize it,
 //! build the map and certify it.
 //!
@@ -105,7 +106,7 @@ pub struct Parametrization {
     pub seconds: f64,
 }
 
-/// The method of digest §6: boundary validation and Lemma 4 assembly
+/// The whole method ([Abelló et al., §2]): boundary validation and Lemma 4 assembly
 /// ([`ControlNet::from_boundary`]), TFI start, interior optimization
 /// ([`optimize_interior`]), the map of `opts.degree` and all certificates
 /// ([`certify_map`]).

@@ -1,32 +1,34 @@
 //! Tensor-product B-spline maps `x(ξ, η) = Σ_i Σ_j P_{i,j} B^k_i(ξ) B^k_j(η)` of order 2
 //! (bilinear, (6)) and 3 (biquadratic, (27)) on the clamped uniform knots of [`crate::knots`]
-//! (seed 003 digest §1–§3).
+//! ([Abelló et al., §1.1–§1.3]).
 //!
 //! # Fast per-patch evaluation
-//! On construction every patch `U_{ij}` is converted to Bézier form (digest §3.6 step 1): in
-//! each direction the local control points `P_a, P_{a+1}, P_{a+2}` of a quadratic segment
-//! `[t_μ, t_{μ+1}]` (0-based span `μ`, `a = μ − 2`) become
-//! `b₀ = ((t_{μ+1} − t_μ)P_a + (t_μ − t_{μ−1})P_{a+1})/(t_{μ+1} − t_{μ−1})`, `b₁ = P_{a+1}`,
+//! On construction every patch `U_{ij}` is converted to Bézier form (step 1 of our working-out of
+//! Observation 3, by the usual knot-insertion formulas): in each direction the local control points
+//! `P_a, P_{a+1}, P_{a+2}` of a quadratic segment `[t_μ, t_{μ+1}]` (0-based span `μ`, `a = μ − 2`)
+//! become `b₀ = ((t_{μ+1} − t_μ)P_a + (t_μ − t_{μ−1})P_{a+1})/(t_{μ+1} − t_{μ−1})`, `b₁ = P_{a+1}`,
 //! `b₂ = ((t_{μ+2} − t_{μ+1})P_{a+1} + (t_{μ+1} − t_μ)P_{a+2})/(t_{μ+2} − t_μ)` (linear segments
 //! are already Bézier). Points and derivatives are then Bernstein sums over 3×3 (2×2) points.
 //!
 //! # Jacobian
-//! `det J = x_ξ y_η − x_η y_ξ` (3). Per patch it is a polynomial of bidegree `(2d−1, 2d−1)`
-//! (`d` the degree; digest erratum 19: bicubic per patch, only C⁰ across breakpoints), stored as
-//! Bernstein coefficients (digest §3.6 step 2, generalised to degree `d`):
+//! `det J = x_ξ y_η − x_η y_ξ` (3). Per patch it is a polynomial of bidegree `(2d−1, 2d−1)` (`d`
+//! the degree; the paper's "bicubic spline" is bicubic per patch, but in general only C⁰ across
+//! breakpoints), stored as Bernstein coefficients (step 2, for any degree `d`):
 //! `c_ab = d²/(Δξ Δη) Σ_{k+k'=a} Σ_{l+l'=b} [C(d−1,k)C(d,k')/C(2d−1,a)]·[C(d,l)C(d−1,l')/C(2d−1,b)]·
 //! det[Δ^u b_{k,l}, Δ^v b_{k',l'}]` with `Δ^u b_{k,l} = b_{k+1,l} − b_{k,l}`,
-//! `Δ^v b_{k,l} = b_{k,l+1} − b_{k,l}` and the patch widths `Δξ, Δη` (step 3: `1/Δξ = n − 2` for
+//! `Δ^v b_{k,l} = b_{k,l+1} − b_{k,l}` and the patch widths `Δξ, Δη` (step 3, `1/Δξ = n − 2` for
 //! uniform biquadratic knots). For `d = 1` the four coefficients are the four triangle
 //! determinants of Prop 1; for `d = 2` they are the 16 coefficients of Observation 3. They are
 //! also kept in the power basis for the fast sampler ([`crate::sample`]).
 //!
 //! # Closed forms (for checking)
-//! [`TensorMap::det_j_closed_form`] evaluates the paper's formulas literally, with the digest's
+//! [`TensorMap::det_j_closed_form`] evaluates the paper's formulas literally, with these
 //! corrections:
-//! * bilinear, Prop 1 with the corrected factor (erratum 3):
+//! * bilinear, Prop 1 with the factor `(n−1)(m−1)` multiplying (the printed (14) divides by it:
+//!   (19)–(20) invert `1/(ξ_{i+1} − ξ_i) = n − 1`):
 //!   `det J = (n−1)(m−1) Σ_{r=i}^{i+1} Σ_{s=j}^{j+1} det[h_{i,s} | v_{r,j}] B²_r(ξ) B²_s(η)`;
-//! * biquadratic, Prop 2 (39) with `α_{r',s'} = γ_{r'} δ_{s'}` (erratum 8):
+//! * biquadratic, Prop 2 (39) with `α_{r',s'} = γ_{r'} δ_{s'}` (the table (40) is garbled
+//!   in print; this reading agrees with finite differences):
 //!   `det J = (n−2)(m−2) Σ_{r=i}^{i+2} Σ_{s=j}^{j+2} Σ_{r'=i}^{i+1} Σ_{s'=j}^{j+1} γ_{r'} δ_{s'}
 //!   det[h_{r',s} | v_{r,s'}] B³_r(ξ) B³_s(η) B²_{r'+1}(ξ) B²_{s'+1}(η)`,
 //!   the `B²` being order-2 B-splines on the same knots (23) and
@@ -410,7 +412,7 @@ impl TensorMap {
         gamma_of(&self.ky, s)
     }
 
-    /// `det J` by the paper's closed forms as corrected in the digest (module docs): Prop 1
+    /// `det J` by the paper's closed forms, corrected (module docs): Prop 1
     /// with the factor `(n−1)(m−1)` for bilinear maps, Prop 2 (39) with `α = γδ` for
     /// biquadratic ones. Uses the literal Cox–de Boor recursion for the `B³` and `B²`.
     pub fn det_j_closed_form(&self, xi: f64, eta: f64) -> f64 {

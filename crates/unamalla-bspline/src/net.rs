@@ -7,27 +7,30 @@
 //! first size is the count along the bottom side). Cells are counter-clockwise
 //! `P_{i,j}, P_{i+1,j}, P_{i+1,j+1}, P_{i,j+1}`.
 //!
-//! # Edge vectors and triangles (digest §2.3–2.4)
+//! # Edge vectors and triangles ([Abelló et al., §1.2])
 //! `h_{i,s} = P_{i+1,s} − P_{i,s}` ("horizontal", (15)), `v_{r,j} = P_{r,j+1} − P_{r,j}`
 //! ("vertical", (16)). Cell `c_{ij}` is split by its diagonals into the four counter-clockwise
 //! triangles `t¹ = △(P_{ij}, P_{i+1,j}, P_{i+1,j+1})`, `t² = △(P_{ij}, P_{i+1,j+1}, P_{i,j+1})`,
 //! `t³ = △(P_{ij}, P_{i+1,j}, P_{i,j+1})`, `t⁴ = △(P_{i+1,j}, P_{i+1,j+1}, P_{i,j+1})`; the cell is
 //! convex iff all four doubled areas are positive (Definition 1, index range corrected to
-//! `i ≤ n−1, j ≤ m−1`, erratum 5). With the corrected labels of §2.5 (erratum 4):
+//! `i ≤ n−1, j ≤ m−1`; the paper prints `i = 1..n, j = 1..m`). The proof of
+//! Theorem 1 swaps the labels `t¹` and `t³`; correctly:
 //! `det[h_{ij}|v_{ij}] = 2·area(t³)`, `det[h_{i,j+1}|v_{ij}] = 2·area(t²)`,
 //! `det[h_{ij}|v_{i+1,j}] = 2·area(t¹)`, `det[h_{i,j+1}|v_{i+1,j}] = 2·area(t⁴)`.
 //!
-//! ε-convexity (Definition 2, erratum 12): every triangle has `α > ε·ᾱ`, `α` the doubled area,
-//! `ᾱ` the mean α, which is fixed by the boundary: `ᾱ = area(Ω')/((n−1)(m−1))` (digest §5.3).
+//! ε-convexity (Definition 2, §2.2, which compares an "area" with `ε·ᾱ`, `ᾱ` a mean of doubled
+//! areas; here both are doubled areas): every triangle has `α > ε·ᾱ`, `α` the doubled area, `ᾱ`
+//! the mean α, which is fixed by the boundary: `ᾱ = area(Ω')/((n−1)(m−1))` (the four triangles
+//! of a cell add up to twice its doubled area, and the cells tile `Ω'`).
 //!
-//! # Boundary (Lemma 4, digest §4)
+//! # Boundary (Lemma 4, [Abelló et al., §2.1])
 //! [`BoundaryCurves`] holds the control points of the south `x_b` (Q→R, `n` points), east `x_r`
 //! (R→S, `m`), north `x_t` (T→S, `n`) and west `x_l` (Q→T, `m`) curves. Lemma 4 sets
-//! `P_{i,1} = H^b_i`, `P_{i,m} = H^t_i`, `P_{1,j} = V^l_j`, `P_{n,j} = V^r_j` ((48)–(49), with the
-//! `j` of erratum 9); then the biquadratic map reproduces the four curves on `∂U`.
-//! [`BoundaryCurves::validate`] checks the conditions listed in §4: counts, corner identities,
-//! counter-clockwise orientation, a simple control polygon `∂Ω'` and strictly convex corners
-//! (a corner belongs to a single cell, so a reflex corner makes a convex net impossible).
+//! `P_{i,1} = H^b_i`, `P_{i,m} = H^t_i`, `P_{1,j} = V^l_j`, `P_{n,j} = V^r_j` ((48)–(49); (49) is
+//! printed with `V^l_i`, `V^r_i` for `V^l_j`, `V^r_j`); then the biquadratic map reproduces the
+//! four curves on `∂U`. [`BoundaryCurves::validate`] checks counts, corner identities,
+//! counter-clockwise orientation, a simple control polygon `∂Ω'` and strictly convex corners (a
+//! corner belongs to a single cell, so a reflex corner makes a convex net impossible).
 
 use glam::DVec2;
 use unamalla_mesh::geometry::orient2d;
@@ -226,8 +229,8 @@ impl ControlNet {
     }
 
     /// Lemma 4 assembly: the boundary of the net from the four curves' control points, the
-    /// interior by discrete TFI of the boundary control polygon (arc-length parameters; the
-    /// recommended start of digest §5.4 — it may be folded, the optimizer of
+    /// interior by discrete TFI of the boundary control polygon (arc-length parameters; the paper
+    /// names no start — it may be folded, the optimizer of
     /// [`crate::interior`] untangles it). The curves are validated first
     /// ([`BoundaryCurves::validate`]).
     pub fn from_boundary(b: &BoundaryCurves) -> Result<Self, BsplineError> {
@@ -248,8 +251,8 @@ impl ControlNet {
     }
 }
 
-/// The control points of the four boundary curves (digest §4): south `Q→R` and north `T→S` with
-/// `n` points, west `Q→T` and east `R→S` with `m` points; corners shared.
+/// The control points of the four boundary curves ([Abelló et al., §2.1]): south `Q→R` and
+/// north `T→S` with `n` points, west `Q→T` and east `R→S` with `m` points; corners shared.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BoundaryCurves {
     /// `H^b_1..H^b_n`, from Q to R.
@@ -283,7 +286,7 @@ impl BoundaryCurves {
         v
     }
 
-    /// Checks the conditions of digest §4 ("Validation is needed in every case"): at least 3
+    /// Checks that the curves can bound a convex control net (the paper assumes it): at least 3
     /// points per curve (quadratic curves), equal counts on opposite sides, finite points,
     /// the corner identities `Q, R, S, T` (within `1e-12` of the polygon's size), a
     /// counter-clockwise and simple control polygon and strictly convex corners.
@@ -373,7 +376,9 @@ impl BoundaryCurves {
         Ok(())
     }
 
-    /// Option (a) of digest §4: a counter-clockwise ring split at four corner indices
+    /// A control polygon from a polyline (the paper does not say how its boundary curves were
+    /// made; this is the closest reading of its "control polygon"): a counter-clockwise ring
+    /// split at four corner indices
     /// `c0 < c1 < c2 < c3` (cyclically, counter-clockwise; `c0` = Q), each side resampled by
     /// arc length to `n` (south/north) or `m` (west/east) points, which are used directly as
     /// control points.
@@ -589,7 +594,8 @@ mod tests {
 
     #[test]
     fn triangle_labels_match_edge_determinants() {
-        // erratum 4: det[h_ij|v_ij] = 2·area(t³), det[h_ij|v_{i+1,j}] = 2·area(t¹), …
+        // Theorem 1's proof swaps t¹ and t³; correctly det[h_ij|v_ij] = 2·area(t³),
+        // det[h_ij|v_{i+1,j}] = 2·area(t¹), …
         let net = ControlNet::new(
             2,
             2,

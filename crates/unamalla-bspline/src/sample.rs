@@ -1,4 +1,4 @@
-//! Dense Jacobian sampling (seed 003 digest §7 and checklist 11): `det J` at `N_ξ × N_η`
+//! Dense Jacobian sampling, as in [Abelló et al., §3, Table 1]: `det J` at `N_ξ × N_η`
 //! equispaced parameters `ξ_a = a/(N_ξ−1)`, `η_b = b/(N_η−1)` (the boundary of `U` included —
 //! the paper does not say whether its 10⁴ × 10⁴ sample did), in parallel (rayon, one task per
 //! row of `η`), returning the minimum and maximum with their locations, the mean and the number
@@ -7,7 +7,7 @@
 //! Each sample costs one cubic Horner evaluation: per row and patch the power-basis coefficients
 //! of `det J` ([`crate::map::Patch::jac_power`]) are contracted with `1, v, v², v³` once, so a
 //! 10⁸-point sample is a few hundred million multiply-adds. The mean of `det J` over `U`
-//! approximates `area(Ω)` for an injective map (`∫_U det J = area(Ω)`, digest §7 note), so
+//! approximates `area(Ω)` for an injective map (`∫_U det J = area(Ω)`), so
 //! `min/mean` is the scale-free number to compare across regions.
 
 use rayon::prelude::*;

@@ -1,30 +1,30 @@
-//! The synthetic test regions S1–S5 of the seed 003 digest (§8): the paper's four regions
+//! The synthetic test regions S1–S5 (our design): the four regions of [Abelló et al., §3]
 //! (Lake Titicaca, a jigsaw-puzzle piece, England, Havana Bay) come without coordinates, so
 //! these exactly constructible stand-ins exercise the same features. Each builds the four
-//! boundary control polygons for an `n × m` net ([`BoundaryCurves`], boundary option (a) of
-//! digest §4: polyline vertices used directly as quadratic B-spline control points, opposite
-//! sides with equal counts).
+//! boundary control polygons for an `n × m` net ([`BoundaryCurves`], as in
+//! [`BoundaryCurves::from_ring`]: polyline vertices used directly as quadratic B-spline control
+//! points, opposite sides with equal counts).
 //!
 //! * **S1** unit square, boundary points uniformly spaced. ([`greville_square`] gives the net
 //!   at the Greville abscissae, for which the biquadratic map is the identity.)
 //! * **S2** wavy square: each side of `[0,1]²` moved along its outward normal by
-//!   `a·sin(2πkt)` at uniform `t`, `a = 0.04`, `k = 5`. The digest does not say which way `t`
-//!   runs; here it runs counter-clockwise along `∂Ω` on every side. (With `t` running T→S on the
-//!   north and Q→T on the west side, both neighbours of corners S and Q move inward for most
-//!   `n`, and at `n = 30` the control polygon folds back on itself at S.)
-//! * **S3** star-shaped lake `r(θ) = 1 + 0.25 sin 7θ + 0.1 cos 13θ`, each side sampled uniformly
-//!   in θ. **Deviation:** with the digest's corners `θ = −3π/4, −π/4, π/4, 3π/4` the corners R
-//!   and S are reflex vertices of the control polygon (the curve is locally concave there:
-//!   `r² + 2r'² − r r'' < 0`), so no convex net can exist; [`star_literal`] keeps that variant
-//!   as a negative test. [`Synthetic::S3Star`] moves each corner to the maximum of
-//!   `r² + 2r'² − r r''` within 0.2 rad of the digest's angle:
+//!   `a·sin(2πkt)` at uniform `t`, `a = 0.04`, `k = 5`, `t` running counter-clockwise along `∂Ω`
+//!   on every side. (With `t` running T→S on the north and Q→T on the west side, both
+//!   neighbours of corners S and Q move inward for most `n`, and at `n = 30` the control polygon
+//!   folds back on itself at S.)
+//! * **S3** star-shaped lake `r(θ) = 1 + 0.25 sin 7θ + 0.1 cos 13θ`, each side sampled uniformly in
+//!   θ. **Deviation** from the first design: with corners at `θ = −3π/4, −π/4, π/4, 3π/4` the
+//!   corners R and S are reflex vertices of the control polygon (the curve is locally concave
+//!   there: `r² + 2r'² − r r'' < 0`), so no convex net can exist; [`star_literal`] keeps that
+//!   variant as a negative test. [`Synthetic::S3Star`] moves each corner to the maximum of
+//!   `r² + 2r'² − r r''` within 0.2 rad of those angles:
 //!   `θ_Q = −2.412, θ_R = −0.585, θ_S = 0.963, θ_T = 2.408`.
 //! * **S4** puzzle piece: the unit square with a knob on the south and east sides and a notch on
 //!   the north and west sides. Knob: a neck of width 0.12 and length 0.1 leaving the side at its
 //!   midpoint, ending in a circle of radius 0.15 through the neck's ends (centre
-//!   `0.1 + √(0.15² − 0.06²) ≈ 0.2375` from the side). **Deviation:** the digest puts the centre
-//!   0.1 from the side, but then the circle crosses the side and no neck forms. The outline is
-//!   resampled by arc length to `n` (`m`) points per side.
+//!   `0.1 + √(0.15² − 0.06²) ≈ 0.2375` from the side). **Deviation** from the first design, which
+//!   put the centre 0.1 from the side: then the circle crosses the side and no neck forms. The
+//!   outline is resampled by arc length to `n` (`m`) points per side.
 //! * **S5** bay: the rectangle `[0, 1.5] × [0, 1]` whose north side has an inlet 0.1 wide and
 //!   0.6 deep centred at `x = 0.75`, resampled by arc length.
 
@@ -162,7 +162,7 @@ impl Synthetic {
     }
 }
 
-/// S3 with the digest's literal corners `θ = −3π/4, −π/4, π/4, 3π/4` (reflex corners R and S:
+/// S3 with the literal corners `θ = −3π/4, −π/4, π/4, 3π/4` (reflex corners R and S:
 /// a negative test, [`BoundaryCurves::validate`] rejects it).
 pub fn star_literal(n: usize, m: usize) -> BoundaryCurves {
     star(

@@ -1,7 +1,7 @@
-//! Theorems 1 and 2, the Bernstein test and the dense sampler on constructed nets (seed 003
-//! digest §2.5, §3.6, §7, §8): convex nets certify, a net where Theorem 2 fails although the map
+//! Theorems 1 and 2, the Bernstein test and the dense sampler on constructed nets ([Abelló et al.,
+//! §1.2–§1.3, §3]): convex nets certify, a net where Theorem 2 fails although the map
 //! is injective, a folded net where sampling finds det J ≤ 0; the synthetic regions S1–S5 and the
-//! negative tests of §8.
+//! negative tests (reflex corner, self-intersection, orientation).
 
 use glam::DVec2;
 use proptest::prelude::*;
@@ -97,12 +97,12 @@ proptest! {
     }
 }
 
-/// A net where Theorem 2 fails but the map is injective (digest Observation 2: (41) is very
-/// restrictive): a polar annulus sector, ξ radial (r from 1 to 2), η angular over 240° with 4
-/// control points, i.e. 80° per control-polygon step. Every control cell is convex, but an
-/// edge h_{r',s} (radial, direction θ_s) and an edge v_{r,s'} two steps away in angle
-/// (tangential, direction θ_{s'} + 90°, |θ_s − θ_{s'}| = 160°) have det < 0. The Bernstein test
-/// (with subdivision) certifies det J > 0, and dense sampling agrees.
+/// A net where Theorem 2 fails but the map is injective ([Abelló et al., Observation 2]: (41) is
+/// very restrictive): a polar annulus sector, ξ radial (r from 1 to 2), η angular over 240° with 4
+/// control points, i.e. 80° per control-polygon step. Every control cell is convex, but an edge
+/// h_{r',s} (radial, direction θ_s) and an edge v_{r,s'} two steps away in angle (tangential,
+/// direction θ_{s'} + 90°, |θ_s − θ_{s'}| = 160°) have det < 0. The Bernstein test (with
+/// subdivision) certifies det J > 0, and dense sampling agrees.
 #[test]
 fn theorem2_fails_but_the_map_is_injective() {
     let (n, m) = (3, 4);
@@ -229,8 +229,7 @@ fn s1_optimizer_keeps_the_uniform_grid() {
     }
 }
 
-/// S4 at 18×18: the TFI start is folded; the optimizer unfolds it (digest §8 S2/S4: "the
-/// optimizer must then unfold it").
+/// S4 at 18×18: the TFI start is folded; the optimizer unfolds it.
 #[test]
 fn s4_tfi_start_is_folded_and_gets_unfolded() {
     let b = Synthetic::S4Puzzle.boundary(18, 18).unwrap();
@@ -241,7 +240,7 @@ fn s4_tfi_start_is_folded_and_gets_unfolded() {
     assert!(rep.convex && rep.eps_convex, "{rep:?}");
 }
 
-/// Negative tests of digest §8: a reflex corner (the literal S3 corners), a self-intersecting
+/// Negative tests: a reflex corner (the literal S3 corners), a self-intersecting
 /// control polygon, clockwise orientation, corners that do not meet, too few points.
 #[test]
 fn invalid_boundaries_are_reported() {

@@ -1,4 +1,4 @@
-//! Property suite of the seed 003 digest §8 ("Property tests derived from the paper's lemmas"):
+//! Property tests derived from the lemmas of [Abelló et al., §1.1–§1.3, §2.1]:
 //! Cox–de Boor basics, (33) vs (34), Lemma 1, Lemma 2, Lemma 4, the corrected Prop 1, Prop 2 (39)
 //! and every derivative path against finite differences, the α = γδ table (40), the S1 exact
 //! checks.
@@ -173,7 +173,7 @@ proptest! {
     /// Partial derivatives: the per-patch Bézier path equals the Cox–de Boor path with (33) and
     /// central finite differences; det J from partials equals the Bernstein form and the
     /// paper's closed forms (Prop 1 corrected, Prop 2 (39) with α = γδ). Both degrees,
-    /// including the single-patch case n = m = 3 (erratum 6).
+    /// including the single-patch case n = m = 3 ((34) holds only for n ≥ 4).
     #[test]
     fn derivatives_and_closed_forms(deg in 1usize..=2, n in 3usize..8, m in 3usize..8, noise in noise_strategy(), s in 0.0f64..1.0, r in 0.0f64..1.0) {
         let net = noisy_net(n, m, &noise, 0.2);
@@ -197,7 +197,7 @@ proptest! {
     }
 
     /// ᾱ (mean doubled triangle area) depends only on the boundary: moving interior points
-    /// leaves it unchanged (digest §5.3, [derived]).
+    /// leaves it unchanged (worked out here; not in the paper).
     #[test]
     fn alpha_bar_is_invariant_under_interior_moves(n in 3usize..8, m in 3usize..8, noise in noise_strategy()) {
         let net = noisy_net(n, m, &noise, 0.1);
@@ -220,7 +220,7 @@ proptest! {
 }
 
 /// (33) = (34) for n ≥ 4 on the uniform biquadratic knots; for n = 3 (34) is wrong
-/// (erratum 6) while (33) matches finite differences.
+/// (a single interval) while (33) matches finite differences.
 #[test]
 fn eq33_equals_eq34_for_n_at_least_4_and_fails_for_n3() {
     // (34), 1-based i, with B²_q the order-2 B-splines on the same knots (0-based q−1)
@@ -262,7 +262,8 @@ fn eq33_equals_eq34_for_n_at_least_4_and_fails_for_n3() {
     assert!((eq34(&k, 3, 2, t) - exact).abs() > 0.4);
 }
 
-/// The printed (14) divides by (n−1)(m−1); the corrected factor multiplies (erratum 3). On the
+/// The printed (14) divides by (n−1)(m−1); the correct factor multiplies
+/// (the paper's (19)–(20) invert `1/(ξ_{i+1} − ξ_i)`). On the
 /// uniform unit-square net with n = 5, m = 4, det J ≡ 1 (the map is the identity), while the
 /// printed formula gives 1/((n−1)(m−1))² = 1/144.
 #[test]
@@ -278,7 +279,7 @@ fn prop1_factor_is_corrected() {
     }
 }
 
-/// The α_{r',s'} table (40) as reconstructed (erratum 8): γ_{r'}δ_{s'} = 4 at the corners, 2
+/// The α_{r',s'} table (40), garbled in print, read as: γ_{r'}δ_{s'} = 4 at the corners, 2
 /// on the edges, 1 inside.
 #[test]
 fn alpha_table_is_gamma_times_delta() {
@@ -297,13 +298,13 @@ fn alpha_table_is_gamma_times_delta() {
             assert!((a - want).abs() < 1e-12, "r'={rp} s'={sp}: {a}");
         }
     }
-    // n = 3: γ_1 = γ_2 = 2 (digest §3.4 [derived])
+    // n = 3: γ_1 = γ_2 = 2 (by the general form γ_r = 2Δ/(t_{r+3} − t_{r+1}))
     let map = TensorMap::new(Degree::Biquadratic, uniform_square(3, 3).unwrap()).unwrap();
     assert!((map.gamma(0) - 2.0).abs() < 1e-12 && (map.gamma(1) - 2.0).abs() < 1e-12);
 }
 
 /// S1 check (i): the net at the Greville abscissae gives the identity map, det J ≡ 1. For
-/// n = 6 the abscissae are 0, 0.125, 0.375, 0.625, 0.875, 1 (digest §8).
+/// n = 6 the abscissae are 0, 0.125, 0.375, 0.625, 0.875, 1 (S1 check (i)).
 #[test]
 fn s1_greville_net_is_the_identity() {
     let g = KnotVector::biquadratic(6).unwrap().greville();
@@ -332,14 +333,15 @@ fn s1_greville_net_is_the_identity() {
 }
 
 /// S1 check (ii): uniformly spaced square net, n = 6, m = 5: det J is positive but not
-/// constant, ranging over about [0.60, 2.39] (digest §8, [verified] there).
+/// constant, ranging over about [0.60, 2.39] (computed
+/// independently when the S1 checks were designed).
 #[test]
 fn s1_uniform_net_jacobian_range() {
     let map = TensorMap::new(Degree::Biquadratic, uniform_square(6, 5).unwrap()).unwrap();
     let s = unamalla_bspline::sample_det_j(&map, 801, 801).unwrap();
     assert!((s.min - 0.60).abs() < 0.006, "min {}", s.min);
-    // the maximum is at a corner, where it is exactly 2.4 (below); the digest's "about 2.39"
-    // agrees to 0.01
+    // the maximum is at a corner, where it is exactly 2.4 (below); the "about 2.39"
+    // above agrees to 0.01
     assert!((s.max - 2.4).abs() < 1e-12, "max {}", s.max);
     assert!((s.max - 2.39).abs() <= 0.0100001);
     // hand check at the corner: x_ξ = (n−2)·γ_1·h = 4·2·(1/5) = 1.6 along x,
@@ -366,7 +368,7 @@ fn curve_derivative_curve() {
     }
 }
 
-/// f of (56) is C² at 1 (digest §5.3): value 1, f' = −1, f'' = 2 from both sides.
+/// f of (56) is C² at 1: value 1, f' = −1, f'' = 2 from both sides.
 #[test]
 fn s_function_is_c2_at_one() {
     let f = unamalla_functionals::s_function;
