@@ -1,5 +1,5 @@
 //! Block-structured meshes: structured blocks glued along whole cuts into one conformal
-//! [`QuadMesh`] (seed 000 digest §5.2, "mesh union").
+//! [`QuadMesh`] (the mesh union of [Méndez 2023, §6.2]).
 //!
 //! A [`BlockMesh2`] keeps both views: every block as a [`StructuredGrid2`] (for structured
 //! output and per-block work) and the global mesh without duplicate nodes (for global smoothing

@@ -20,7 +20,7 @@ pub fn orient2d(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     )
 }
 
-/// The doubled signed area α(P, Q, R) = det(Q − P, R − P) (seed 001 digest §1), in plain
+/// The doubled signed area α(P, Q, R) = det(Q − P, R − P) ([González Flores, (2.68)]), in plain
 /// floating point (use [`orient2d`] when only the sign matters and must be exact).
 #[inline]
 pub fn doubled_signed_area(p: DVec2, q: DVec2, r: DVec2) -> f64 {

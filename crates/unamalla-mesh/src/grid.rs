@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::MeshError;
 use crate::traits::{FreeNodes, HasHexCells, HasNodes, HasQuadCells};
 
-/// A structured 2D grid of `m × n` nodes (seed 000 digest §1.1; seed 001 digest §1).
+/// A structured 2D grid of `m × n` nodes ([Méndez 2023, §2.1.1]; [González Flores, Def 2.2]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StructuredGrid2 {
     m: usize,
@@ -160,7 +160,7 @@ impl FreeNodes for StructuredGrid2 {
     }
 }
 
-/// A structured 3D grid of `m × n × p` nodes (seed 004 digest §3.2).
+/// A structured 3D grid of `m × n × p` nodes ([Cortés Aguirre 2012, §3.2, (3.14)]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StructuredGrid3 {
     m: usize,

@@ -11,7 +11,8 @@
 //!   counter-clockwise `(i,j), (i+1,j), (i+1,j+1), (i,j+1)`;
 //! * α (triangle measure) is the doubled signed area `det(Q − P, R − P)`.
 
-// No unwrap/expect in library code: user input must give an error, never a panic (issue #10/#14).
+// No unwrap/expect in library code: user input must give an error, never a panic (see
+// docs/reliability.md).
 // Tests and doc examples may use them.
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 

@@ -1,4 +1,4 @@
-//! Uniform refinement of structured grids (seed 001 digest §6, requirement RF11).
+//! Uniform refinement of structured grids ([González Flores, §6.1.7], requirement RF11).
 //!
 //! `m′` new coordinate lines are inserted between every two consecutive `i`-lines and `n′`
 //! between every two consecutive `j`-lines by bilinear interpolation inside each cell, so an

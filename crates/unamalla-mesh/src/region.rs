@@ -1,7 +1,7 @@
 //! Polygons and polygonal regions with holes, validated on construction.
 //!
 //! A [`Region`] is a closed bounded set whose boundary is a collection of mutually disjoint simple
-//! polygons: the outer ring P₀ and the holes P₁..P_m inside it (seed 000 digest §0). Rings are
+//! polygons: the outer ring P₀ and the holes P₁..P_m inside it ([Méndez 2023, Ch. 2]). Rings are
 //! stored **open** (the first point is not repeated), the outer ring counter-clockwise and holes
 //! clockwise, so the region always lies to the left of every directed boundary edge. Input in
 //! the other orientation is normalised (reversed keeping vertex 0 first), never rejected.
@@ -23,7 +23,8 @@ use crate::spatial::SegmentIndex;
 /// Largest accepted coordinate magnitude. Shewchuk's `orient2d` is exact only while the
 /// products of coordinate differences do not overflow: differences ≤ 2·10¹⁵⁰ give products
 /// ≤ 4·10³⁰⁰ < f64::MAX. Larger coordinates made `orient2d` return ±∞/NaN and validation accept
-/// self-intersecting or misoriented rings (found by the `region` fuzz target, issue #14).
+/// self-intersecting or misoriented rings (found by the `region` fuzz target; see
+/// `docs/reliability.md`).
 pub const MAX_COORDINATE: f64 = 1e150;
 
 /// Smallest accepted non-zero coordinate magnitude (zero is accepted). Two distinct doubles of
@@ -140,8 +141,8 @@ impl Polygon {
 /// the textbook `½ Σ_k p_k × p_{k+1}` in exact arithmetic (the shoelace sum is invariant
 /// under translation), but in floating point the textbook form cancels catastrophically far
 /// from the origin: for a ring near (10⁹, 10⁹) the products are ~10¹⁸ and their rounding
-/// errors ~10², larger than the area of a 10 × 10 ring (found by the `region` fuzz target,
-/// issue #14). Relative to `p_0` the error scales with the ring's own extent.
+/// errors ~10², larger than the area of a 10 × 10 ring (found by the `region` fuzz target).
+/// Relative to `p_0` the error scales with the ring's own extent.
 pub fn signed_area(ring: &[DVec2]) -> f64 {
     let Some(&o) = ring.first() else {
         return 0.0;
@@ -415,7 +416,7 @@ impl Region {
     }
     /// `true` if the open segment `(p, q)` lies in the open region: it meets the boundary at
     /// most at its endpoints (which may be boundary points) and its midpoint is inside. This is
-    /// the admissibility test of a cut (seed 000 digest §3). For many queries build
+    /// the admissibility test of a cut ([Méndez 2023, §4.1]). For many queries build
     /// [`Region::edge_index`] once and use [`Region::segment_inside_with`].
     pub fn segment_inside(&self, p: DVec2, q: DVec2) -> bool {
         self.segment_inside_with(&self.edge_index(), p, q)

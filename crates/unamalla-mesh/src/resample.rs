@@ -1,4 +1,4 @@
-//! Arc-length reparametrization of polylines (seed 000 digest §4.5, thesis §5.3).
+//! Arc-length reparametrization of polylines ([Méndez 2023, §5.3]).
 //!
 //! An open polyline γ with vertices v₁..v_s and cumulative arc lengths L₁ = 0 < … < L_s = L is
 //! the linear spline β(t) through (L_i, v_i); evaluating β at the uniform partition

@@ -1,6 +1,6 @@
 //! Transfinite interpolation (discrete Coons patches) in 2D and 3D.
 //!
-//! **2D** (seed 000 digest §5.1, thesis §6.1): with bottom/top points `B_i, T_i` (`i = 0..m`,
+//! **2D** ([Méndez 2023, §6.1]): with bottom/top points `B_i, T_i` (`i = 0..m`,
 //! left to right), left/right points `L_j, R_j` (`j = 0..n`, bottom to top), corners
 //! `P00 = B_0, P10 = B_{m−1}, P01 = T_0, P11 = T_{m−1}` and parameters `ξ_i, η_j` in `[0, 1]`:
 //!
@@ -15,7 +15,8 @@
 //! (`ξ_i = ½(s_b(i) + s_t(i))`, `η_j = ½(s_l(j) + s_r(j))`), which keeps the interior spacing
 //! close to the boundary spacing when the boundary points are not uniform.
 //!
-//! **3D** (seed 004 digest §2, recommended reading marked "I"): the Boolean sum
+//! **3D** (used but not printed by [Cortés Aguirre 2012, §2.2.1]; the standard form, after
+//! [Knupp & Steinberg 1993]): the Boolean sum
 //! `X = U + V + W − UV − UW − VW + UVW` of the linear blends between opposite faces, edges and
 //! corners, with uniform parameters `ξ_i = i/(m−1)` etc.
 

@@ -1,4 +1,4 @@
-//! Regression tests for defects found by the fuzz targets of `fuzz/` (issue #14,
+//! Regression tests for defects found by the fuzz targets of `fuzz/` (see
 //! `docs/reliability.md`).
 
 use unamalla_mesh::{DVec2, Region};

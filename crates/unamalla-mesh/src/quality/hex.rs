@@ -3,7 +3,7 @@
 //!
 //! Three families:
 //!
-//! * **Verdict** metrics (`V_HexMetric.cpp`; reference notes §2): Jacobian, scaled Jacobian,
+//! * **Verdict** metrics ([Verdict, `V_HexMetric.cpp`]): Jacobian, scaled Jacobian,
 //!   condition, shape, skew, taper, Oddy, written with the corner matrices
 //!   `A0 = (L0, L3, L4)`, `A1 = (L1, −L0, L5)`, `A2 = (L2, −L1, L6)`, `A3 = (−L3, −L2, L7)`,
 //!   `A4 = (L11, L8, −L4)`, `A5 = (−L8, L9, −L5)`, `A6 = (−L9, L10, −L6)`,
@@ -11,8 +11,9 @@
 //!   `L0 = P1−P0, L1 = P2−P1, L2 = P3−P2, L3 = P3−P0, L4..L7 = P4−P0, P5−P1, P6−P2, P7−P3,
 //!   L8 = P5−P4, L9 = P6−P5, L10 = P7−P6, L11 = P7−P4` and `X1, X2, X3` are the sums of the
 //!   four parallel edges. `αi = det Ai`.
-//! * the **10-tetrahedra** split of seed 004 digest §3.2 ([`HEX_TETS`]) and its convexity test;
-//! * the **face-planarity** cosine of seed 004 digest §4 ([`face_planarity`]).
+//! * the **10-tetrahedra** split of [Cortés Aguirre 2012, §3.2] ([`HEX_TETS`]) and its convexity
+//!   test;
+//! * the **face-planarity** cosine of [Cortés Aguirre 2012, §4.1, (4.2)] ([`face_planarity`]).
 //!
 //! Degenerate input never panics and never gives NaN for finite coordinates; the Verdict
 //! fallbacks are documented on each function.
@@ -22,9 +23,10 @@ use serde::{Deserialize, Serialize};
 
 use super::quad::{DBL_MAX, DBL_MIN};
 
-/// The ten tetrahedra of a hex (seed 004 digest §3.2, Azarenok's split as reconstructed
-/// there), 0-based VTK vertex ids `[P, Q, R, S]`, oriented so that
-/// `V = (S − P)·((Q − P) × (R − P)) > 0` on the unit cube.
+/// The ten tetrahedra of a hex (Azarenok's split, [Cortés Aguirre 2012, §3.2]; the text names
+/// 1245, 6572, 8547, 5861 and the interior tet 7425, the full list is its Fig. 3.9), 0-based
+/// VTK vertex ids `[P, Q, R, S]`, oriented so that `V = (S − P)·((Q − P) × (R − P)) > 0` on the
+/// unit cube.
 ///
 /// Rows 0–4 are decomposition A (1-based: corner tets 1245, 3427, 6572, 8547 and the interior
 /// tet 7425), rows 5–9 decomposition B (corner tets 2316, 4138, 5861, 7683 and the interior
@@ -49,7 +51,7 @@ pub const HEX_TET_INTERIOR: [bool; 10] = [
     false, false, false, false, true, false, false, false, false, true,
 ];
 
-/// The six faces used by the planarity test (seed 004 digest §4), 0-based VTK ids; 1-based
+/// The six faces used by the planarity test ([Cortés Aguirre 2012, §4.1]), 0-based VTK ids; 1-based
 /// they are (1234), (5678), (1265), (4378), (1485), (2376). Each is a cycle around the face.
 pub const PLANARITY_FACES: [[usize; 4]; 6] = [
     [0, 1, 2, 3],
@@ -61,7 +63,7 @@ pub const PLANARITY_FACES: [[usize; 4]; 6] = [
 ];
 
 /// `V = (S − P)·((Q − P) × (R − P))` of the tetrahedron `(P, Q, R, S)`: six times its signed
-/// volume (seed 004 digest §3.2, eq. 3.21).
+/// volume ([Cortés Aguirre 2012, (3.21)]).
 #[inline]
 pub fn tet_det(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> f64 {
     (s - p).dot((q - p).cross(r - p))
@@ -86,9 +88,10 @@ pub fn hex_tet_volumes(h: &[DVec3; 8]) -> [f64; 10] {
     hex_tet_dets(h).map(|v| v / 6.0)
 }
 
-/// The thesis's tetrahedron Jacobians `V` (seed 004 digest §3.2): `6 × volume` for the corner
-/// tets (`r_ξ = Q − P`, `r_η = R − P`, `r_ζ = S − P`) and `3 × volume` for the interior tets
-/// (volume-averaged gradient, digest erratum 5). All equal 1 on the unit cube.
+/// The thesis's tetrahedron Jacobians `V` ([Cortés Aguirre 2012, §3.2]): `6 × volume` for the
+/// corner tets (`r_ξ = Q − P`, `r_η = R − P`, `r_ζ = S − P`) and `3 × volume` for the interior
+/// tets (their volume-averaged gradient gives `3 ×`, not the `6 ×` the thesis states for all).
+/// All equal 1 on the unit cube.
 pub fn hex_tet_jacobians(h: &[DVec3; 8]) -> [f64; 10] {
     let mut v = hex_tet_dets(h);
     for (t, x) in v.iter_mut().enumerate() {
@@ -99,15 +102,15 @@ pub fn hex_tet_jacobians(h: &[DVec3; 8]) -> [f64; 10] {
     v
 }
 
-/// The 10-tetrahedra convexity test of seed 004 digest §3.2 (eq. 3.24) with a threshold:
+/// The 10-tetrahedra convexity test of [Cortés Aguirre 2012, §3.2.1, (3.24)] with a threshold:
 /// `true` iff every [`hex_tet_dets`] value is `> threshold` (6 × volume units). The thesis's
-/// test is `threshold = 0`; digest §9 reports cells with some `V ≤ ε·v̄` as non-convex, for
-/// which pass `threshold = ε·v̄`.
+/// test is `threshold = 0`; its ε-convexity test (3.35) calls a cell with some `V ≤ ε·v̄`
+/// non-convex, for which pass `threshold = ε·v̄`.
 pub fn hex_is_convex_10tet(h: &[DVec3; 8], threshold: f64) -> bool {
     hex_tet_dets(h).iter().all(|&v| v > threshold)
 }
 
-/// `|cos θ|` of one face `ABCD` (seed 004 digest §4, eq. 4.2): `N = AB × AD`,
+/// `|cos θ|` of one face `ABCD` ([Cortés Aguirre 2012, (4.2)]): `N = AB × AD`,
 /// `k = |N·AC| / (‖N‖‖AC‖)`, maximised over the four rotations of the face (each leaves one
 /// vertex out of the plane triple: vertex `A` with neighbours `B, D` spans the plane, the
 /// opposite vertex `C` is tested). 0 for a planar face; a rotation whose triple is degenerate
@@ -632,7 +635,7 @@ mod tests {
         // 7425 = [6,3,1,4] has Q−P = (0,0,−1), R−P = (1,−1,−1), S−P = (1,−1,0),
         // (Q−P)×(R−P) = (−1,−1,0), V = 0 (flat), and likewise 1386. Past 90° the interior
         // tets invert while the corner tets (= Verdict's eight corner Jacobians) stay positive:
-        // the case the 8-corner test misses (digest §3.2, Fig. 3.7).
+        // the case the 8-corner test misses ([Cortés Aguirre 2012, §3.2.1, Fig. 3.7]).
         let h = twist(95f64.to_radians());
         let d = hex_tet_dets(&h);
         for t in 0..10 {

@@ -19,12 +19,12 @@ use crate::traits::{HasHexCells, HasQuadCells};
 /// Meshes with at least this many cells are evaluated in parallel (rayon).
 pub const PARALLEL_THRESHOLD: usize = 2048;
 
-/// μ threshold of a "good" cell (seed 000 digest §1.4: blue band, τ = 0.8).
+/// μ threshold of a "good" cell ([Méndez 2023, §2.2]: blue band, τ = 0.8).
 pub const MU_GOOD: f64 = 0.8;
-/// Lower μ limit of the "fair" band (seed 000 digest §1.4: orange band 0.4 ≤ μ < 0.8).
+/// Lower μ limit of the "fair" band ([Méndez 2023, §2.2]: orange band 0.4 ≤ μ < 0.8).
 pub const MU_FAIR: f64 = 0.4;
 /// Fraction of cells with μ ≥ [`MU_GOOD`] that makes a mesh "high quality"
-/// (seed 000 digest §1.4: p = 85 %).
+/// ([Méndez 2023, §2.2]: p = 85 %).
 pub const HIGH_QUALITY_FRACTION: f64 = 0.85;
 
 fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send) -> Vec<R> {
@@ -47,13 +47,15 @@ pub fn hex_metrics_per_cell<M: HasHexCells + ?Sized>(mesh: &M) -> Vec<HexMetrics
     par_map(&cells, HexMetrics::compute)
 }
 
-/// Statistics of the corner-triangle measure α over a quad mesh (seed 001 digest §1 and §4).
+/// Statistics of the corner-triangle measure α over a quad mesh ([González Flores, §4.1,
+/// Table A.1]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AlphaStats {
     /// Number of triangles `N = 4 × cells`.
     pub num_triangles: usize,
     /// `Σ α` over all triangles; equals `4·area(Ω)` for any grid with the given boundary,
-    /// folded or not (digest §1, "key identity").
+    /// folded or not (the thesis's (3.53), (3.61), stated for positively oriented triangles, holds
+    /// with signed α for any grid).
     pub sum: f64,
     /// `ᾱ = 4·area(Ω)/N`, computed as `Σα / N` (equal by the identity above); 0 for an empty
     /// mesh.
@@ -74,8 +76,8 @@ impl AlphaStats {
         }
     }
 
-    /// ε-convexity (design brief; seed 001 digest §1, §4): `α₋ > ε·ᾱ`. The thesis's quality
-    /// target is `ε = 0.01`; `ε = 0` is plain convexity.
+    /// ε-convexity: `α₋ > ε·ᾱ`. The quality target of [González Flores, (4.36)] is
+    /// `ε = 0.01`; `ε = 0` is plain convexity.
     pub fn is_eps_convex(&self, eps: f64) -> bool {
         self.num_triangles > 0 && self.min > eps * self.mean
     }
@@ -133,7 +135,7 @@ pub fn non_convex_cells<M: HasQuadCells + ?Sized>(mesh: &M) -> Vec<usize> {
         .collect()
 }
 
-/// The μ quality bands of seed 000 digest §1.4, as **percentages** of the cells:
+/// The μ quality bands of [Méndez 2023, §2.2], as **percentages** of the cells:
 /// good (blue) `μ ≥ 0.8`, fair (orange) `0.4 ≤ μ < 0.8`, poor (red) `μ < 0.4` (including
 /// non-convex cells, μ ≤ 0, and NaN). All 0 for an empty mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -171,7 +173,7 @@ impl MuBands {
     }
 }
 
-/// Histogram of μ over `[0, 1]` (seed 000 digest §1.4, "quality histogram") with a
+/// Histogram of μ over `[0, 1]` (the "quality histogram" of [Méndez 2023, §2.2]) with a
 /// configurable number `B` of equal bins: a cell with `μ > 0` goes to bin
 /// `k = min(⌊μ·B⌋, B − 1)`, so bin `k` is `[k/B, (k+1)/B)` and the last bin is closed at 1. Cells with **μ ≤ 0** (non-convex, degenerate or folded) and NaN are **not**
 /// in any bin: they are counted in [`non_positive`](Self::non_positive), so that
@@ -211,7 +213,7 @@ impl MuHistogram {
     }
 }
 
-/// The high-quality verdict of seed 000 digest §1.4: at least 85 % of the cells have
+/// The high-quality verdict of [Méndez 2023, §2.2]: at least 85 % of the cells have
 /// μ ≥ 0.8. An empty mesh is not high quality.
 pub fn is_high_quality(mu: &[f64]) -> bool {
     !mu.is_empty()
@@ -307,11 +309,11 @@ impl InteriorValence {
     }
 }
 
-/// Interior singularities of a quad mesh (design card: meshes "without interior
-/// singularities"). **Interior** is computed from the connectivity, not from the fixed flags:
-/// a node is interior iff it belongs to some cell and to no boundary edge (an edge used by
-/// exactly one cell). A structured grid, or block grids merged conformally, has valence 4 at
-/// every interior node, so its count is 0 (seed 000 digest §1.1: "valence: interior 4").
+/// Interior singularities of a quad mesh (the goal of [Méndez 2023, §1.1]: meshes "without
+/// interior singularities"). **Interior** is computed from the connectivity, not from the
+/// fixed flags: a node is interior iff it belongs to some cell and to no boundary edge (an edge
+/// used by exactly one cell). A structured grid, or block grids merged conformally, has valence
+/// 4 at every interior node, so its count is 0 ([Méndez 2023, §2.1.1]: valence 4 inside).
 pub fn interior_singularities<M: HasQuadCells + ?Sized>(mesh: &M) -> InteriorValence {
     let edges = quad_edges(mesh);
     let n = mesh.num_nodes();
@@ -397,8 +399,8 @@ pub(crate) fn hex_arrays(m: &[HexMetrics]) -> Vec<(&'static str, Vec<f64>)> {
 }
 
 /// Number of hexes failing the 10-tetrahedra test with threshold `ε·v̄`, where `v̄` is the mean
-/// of all `10 × cells` tetrahedron values `V = 6 × volume` (seed 004 digest §9: "a cell is
-/// non-convex if any V ≤ ε·v̄"); `ε = 0` is the thesis's plain test (any `V ≤ 0`).
+/// of all `10 × cells` tetrahedron values `V = 6 × volume` ([Cortés Aguirre 2012, (3.35)]: a
+/// cell is non-convex if any `V ≤ ε·v̄`); `ε = 0` is the thesis's plain test (any `V ≤ 0`).
 pub fn hex_non_convex_count<M: HasHexCells + ?Sized>(mesh: &M, eps: f64) -> usize {
     hex_non_convex_from(&hex_metrics_per_cell(mesh), eps)
 }
@@ -445,7 +447,7 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
         /// Σα over all triangles = 4·area(Ω) whatever the interior nodes (folded or not),
-        /// area from the shoelace formula of the boundary loop (seed 001 digest §1).
+        /// area from the shoelace formula of the boundary loop ([González Flores, (3.53)]).
         #[test]
         fn sum_alpha_is_four_times_area(
             m in 3usize..8, n in 3usize..8,
@@ -492,7 +494,7 @@ mod tests {
         assert_eq!(v.interior_nodes, 4 * 3);
         assert_eq!(v.count(), 0);
         let val = quad_node_valences(&g);
-        // corners 2, other boundary nodes 3, interior 4 (seed 000 digest §1.1)
+        // corners 2, other boundary nodes 3, interior 4 ([Méndez 2023, §2.1.1])
         assert_eq!(val[g.index(0, 0)], 2);
         assert_eq!(val[g.index(2, 0)], 3);
         assert_eq!(val[g.index(2, 2)], 4);

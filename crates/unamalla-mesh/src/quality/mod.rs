@@ -3,19 +3,20 @@
 //! # Per cell
 //!
 //! * [`quad`]: for a planar quad `[P0, P1, P2, P3]` (counter-clockwise)
-//!   - the four **corner-triangle measures α** (doubled signed areas; seed 001 digest §1) and
-//!     convexity (all α > 0);
-//!   - the **μ "rectangles 2015"** measure (seed 000 digest §1.4, with doubled signed areas:
+//!   - the four **corner-triangle measures α** (doubled signed areas;
+//!     [González Flores, (2.53)]) and convexity (all α > 0);
+//!   - the **μ "rectangles 2015"** measure ([Méndez 2023, §2.2], with doubled signed areas:
 //!     μ(rectangle) = 1, μ(parallelogram θ) = sin θ, μ ≤ 0 for non-convex cells);
-//!   - the **Verdict** quad metrics (`V_QuadMetric.cpp`, reference notes §2): Jacobian, scaled
+//!   - the **Verdict** quad metrics ([Verdict, `V_QuadMetric.cpp`]): Jacobian, scaled
 //!     Jacobian, condition, shape, skew, taper, aspect ratio, edge ratio, min/max angle, Oddy,
 //!     specialised to the plane with the fixed normal `+z` so that folded cells get negative
 //!     signed values (see the [`quad`] module documentation).
 //! * [`hex`]: for a hexahedron in VTK order
 //!   - the **Verdict** hex metrics (`V_HexMetric.cpp`): Jacobian, scaled Jacobian, condition
 //!     (legacy max-aspect-Frobenius form over the 8 corners), shape, skew, taper, Oddy;
-//!   - the **10-tetrahedra** split [`HEX_TETS`] and its convexity test (seed 004 digest §3.2);
-//!   - the **face-planarity** `|cos θ|` per face and per cell (seed 004 digest §4).
+//!   - the **10-tetrahedra** split [`HEX_TETS`] and its convexity test
+//!     ([Cortés Aguirre 2012, §3.2]);
+//!   - the **face-planarity** `|cos θ|` per face and per cell ([Cortés Aguirre 2012, §4.1]).
 //!
 //! Ideal values: a square / cube has scaled Jacobian 1, condition 1, shape 1, skew 0, taper 0,
 //! Oddy 0 (and, for the square, aspect ratio 1, edge ratio 1, angles 90°, μ = 1).

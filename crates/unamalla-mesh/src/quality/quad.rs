@@ -1,6 +1,6 @@
 //! Per-cell quality metrics of a planar quadrilateral `[P0, P1, P2, P3]` listed counter-clockwise.
 //!
-//! # Notation (Verdict, `V_QuadMetric.cpp`; reference notes §2)
+//! # Notation ([Verdict, `V_QuadMetric.cpp`])
 //!
 //! * edges `L0 = P1 − P0`, `L1 = P2 − P1`, `L2 = P3 − P2`, `L3 = P0 − P3`;
 //! * principal axes `X1 = (P1 − P0) + (P2 − P3)`, `X2 = (P2 − P1) + (P3 − P0)` and the
@@ -15,7 +15,7 @@
 //! `αk = (Nk)_z`, the signed 2D cross product. This is exactly the thesis measure
 //! `α = det(Q − P, R − P)` (doubled signed area) of the four corner triangles
 //! `Δ¹ = (P,Q,S)`, `Δ² = (Q,R,P)`, `Δ³ = (R,S,Q)`, `Δ⁴ = (S,P,R)` of the cell `(P,Q,R,S)`
-//! (seed 001 digest §1): `αk` is the α of the triangle whose corner is `Pk`. Consequences:
+//! ([González Flores, (2.53)]): `αk` is the α of the triangle whose corner is `Pk`. Consequences:
 //!
 //! * a non-convex (dart) or folded (bow-tie) cell gets negative corner values, a cell listed
 //!   clockwise gets all four negative (Verdict, not knowing the plane's orientation, would flip
@@ -61,7 +61,7 @@ fn is_collapsed(q: &[DVec2; 4]) -> bool {
     q[3] == q[2]
 }
 
-/// The four corner α of a cell `(P, Q, R, S)` (seed 001 digest §1, eq. 2.53):
+/// The four corner α of a cell `(P, Q, R, S)` ([González Flores, (2.53)]):
 /// `[α(P,Q,S), α(Q,R,P), α(R,S,Q), α(S,P,R)]` with `α(A,B,C) = det(B − A, C − A)`, the
 /// doubled signed area. Entry `k` is the corner at `Pk`, and equals Verdict's signed corner
 /// area `αk = n̂c · Nk` with `n̂c = +z` (see the module documentation).
@@ -76,7 +76,8 @@ pub fn corner_alphas(q: &[DVec2; 4]) -> [f64; 4] {
     ]
 }
 
-/// Minimum of the four corner α (seed 001 digest §1, "grado de convexidad" of one cell).
+/// Minimum of the four corner α (the "grado de convexidad" of [González Flores, §4.1], for
+/// one cell).
 #[inline]
 pub fn min_alpha(q: &[DVec2; 4]) -> f64 {
     let a = corner_alphas(q);
@@ -84,7 +85,7 @@ pub fn min_alpha(q: &[DVec2; 4]) -> f64 {
 }
 
 /// `true` iff the cell is strictly convex: all four corner α are positive
-/// (seed 001 digest §1; design brief "a cell is convex iff all four α > 0").
+/// ([González Flores, §4.1]).
 #[inline]
 pub fn is_convex(q: &[DVec2; 4]) -> bool {
     alphas_convex(&corner_alphas(q))
@@ -97,16 +98,16 @@ pub fn alphas_convex(alphas: &[f64; 4]) -> bool {
     alphas.iter().all(|&a| a > 0.0)
 }
 
-/// The "rectangles 2015" quality measure μ (seed 000 digest §1.4, González):
+/// The "rectangles 2015" quality measure μ ([Méndez 2023, §2.2], after González):
 ///
 /// `μ(Q) = 2·min(a₁, a₂, a₃, a₄) / √((a² + c²)(b² + d²))`
 ///
 /// with side lengths `a = |AB|, b = |BC|, c = |CD|, d = |DA|` and `a₁..a₄` the **doubled
-/// signed** areas of the triangles `ABC, CDA, ABD, BCD` (the digest's note: with ordinary
-/// areas a rectangle would score ½). These four triangles are the four corner triangles, so
-/// `min aᵢ` = [`min_alpha`]. Then μ(rectangle) = 1, μ(parallelogram with angle θ) = sin θ,
-/// μ ≤ 1 by Cauchy–Schwarz, and a non-convex or folded cell gets μ ≤ 0 (down to −2, since
-/// `|αk| ≤ ‖Lk‖‖Lk−1‖ ≤ √((a² + c²)(b² + d²))`).
+/// signed** areas of the triangles `ABC, CDA, ABD, BCD` (the thesis says "areas"; with
+/// ordinary areas a rectangle would score ½). These four triangles are the four corner
+/// triangles, so `min aᵢ` = [`min_alpha`]. Then μ(rectangle) = 1, μ(parallelogram with angle
+/// θ) = sin θ, μ ≤ 1 by Cauchy–Schwarz, and a non-convex or folded cell gets μ ≤ 0 (down to
+/// −2, since `|αk| ≤ ‖Lk‖‖Lk−1‖ ≤ √((a² + c²)(b² + d²))`).
 /// A cell with two opposite sides of zero length (zero denominator) gets μ = 0.
 pub fn mu(q: &[DVec2; 4]) -> f64 {
     let l = edges(q);
@@ -318,7 +319,7 @@ pub fn edge_ratio(q: &[DVec2; 4]) -> f64 {
 }
 
 /// The four interior corner angles in degrees: `θk = acos(−Lk−1·Lk / (‖Lk−1‖‖Lk‖))`, and
-/// `360° − θk` where `αk < 0` (the reflex branch, reference notes §2). `None` if an edge has
+/// `360° − θk` where `αk < 0` (the reflex branch of Verdict's angles). `None` if an edge has
 /// zero length.
 pub fn corner_angles(q: &[DVec2; 4]) -> Option<[f64; 4]> {
     let l = edges(q);
@@ -341,8 +342,8 @@ pub fn corner_angles(q: &[DVec2; 4]) -> Option<[f64; 4]> {
 /// Verdict quad **minimum angle** (`quad_minimum_angle`), degrees: the smallest of
 /// [`corner_angles`]; 90° for a rectangle. Zero-length edge: 360° (Verdict's fallback);
 /// collapsed quad: the triangle's minimum angle. Unlike Verdict, a reflex corner (`αk < 0`)
-/// counts as `360° − θk`, as the reference notes define it (Verdict applies the reflex branch
-/// only to the maximum angle); for convex cells the two agree.
+/// counts as `360° − θk` here too (Verdict applies the reflex branch only to the maximum
+/// angle); for convex cells the two agree.
 pub fn min_angle(q: &[DVec2; 4]) -> f64 {
     if is_collapsed(q) {
         return tri_min_max_angle(q[0], q[1], q[2]).0;
@@ -394,11 +395,11 @@ pub fn oddy(q: &[DVec2; 4]) -> f64 {
 /// them at construction; the report's statistics skip NaN values and count them).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct QuadMetrics {
-    /// The four corner α (doubled signed corner-triangle areas), seed 001 digest §1.
+    /// The four corner α (doubled signed corner-triangle areas), [González Flores, (2.53)].
     pub alphas: [f64; 4],
     /// `true` iff all four α > 0.
     pub convex: bool,
-    /// μ, "rectangles 2015" (seed 000 digest §1.4).
+    /// μ, "rectangles 2015" ([Méndez 2023, §2.2]).
     pub mu: f64,
     /// Verdict Jacobian.
     pub jacobian: f64,

@@ -19,12 +19,12 @@ pub struct ReportOptions {
     /// Number of μ histogram bins over `[0, 1]` (default 20, bins of 0.05 as in the thesis's
     /// "0.95 ≤ μ ≤ 1" example).
     pub histogram_bins: usize,
-    /// ε of the 2D ε-convexity test `α₋ > ε·ᾱ` (default 0.01, the thesis's target;
-    /// seed 001 digest §4).
+    /// ε of the 2D ε-convexity test `α₋ > ε·ᾱ` (default 0.01, the target of
+    /// [González Flores, (4.36)]).
     pub epsilon: f64,
     /// ε of the hex 10-tetrahedra test `V > ε·v̄` (default 0: plain positivity).
     pub tet_epsilon: f64,
-    /// Face-planarity tolerance on `|cos θ|` (default `1e-2`, seed 004 digest §4/§9).
+    /// Face-planarity tolerance on `|cos θ|` (default `1e-2`, [Cortés Aguirre 2012, §4.2]).
     pub planarity_tolerance: f64,
 }
 
@@ -102,7 +102,7 @@ impl MetricSummary {
 /// Quad-only part of a [`QualityReport`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct QuadSummary {
-    /// ᾱ = 4·area(Ω)/N (seed 001 digest §1).
+    /// ᾱ = 4·area(Ω)/N ([González Flores, (4.31)]).
     pub alpha_mean: f64,
     /// α₋ = min α ("Alfamin").
     pub alpha_min: f64,
@@ -116,11 +116,11 @@ pub struct QuadSummary {
     pub interior_nodes: usize,
     /// Interior nodes with valence ≠ 4.
     pub interior_singularities: usize,
-    /// μ bands in % (seed 000 digest §1.4).
+    /// μ bands in % ([Méndez 2023, §2.2]).
     pub mu_bands: MuBands,
     /// μ histogram over [0, 1]; μ ≤ 0 counted separately.
     pub mu_histogram: MuHistogram,
-    /// High-quality verdict: ≥ 85 % of the cells with μ ≥ 0.8 (seed 000 digest §1.4).
+    /// High-quality verdict: ≥ 85 % of the cells with μ ≥ 0.8 ([Méndez 2023, §2.2]).
     pub high_quality: bool,
 }
 
@@ -135,7 +135,7 @@ pub struct HexSummary {
     pub tet_mean: f64,
     /// ε of the test `V > ε·v̄`.
     pub tet_epsilon: f64,
-    /// Largest face `|cos θ|` over all faces of all cells (seed 004 digest §4).
+    /// Largest face `|cos θ|` over all faces of all cells ([Cortés Aguirre 2012, §4.1]).
     pub max_face_cos: f64,
     /// Tolerance on `|cos θ|`.
     pub planarity_tolerance: f64,
