@@ -1,4 +1,4 @@
-//! Layout evaluation harness (issue #22): meshes regions end to end with a chosen layout and
+//! Layout evaluation harness (block layouts): meshes regions end to end with a chosen layout and
 //! prints one JSON line per region (cells, blocks, μ ≥ 0.8 share, non-convex cells,
 //! singularities, stage times).
 //!

@@ -1,9 +1,9 @@
-//! Time to quality on the sinusoidal TFI grid (issue #23): the pipeline's smoother
-//! ([`unamalla_core::pipeline::default_smooth_options`]: (6.8) at σ = 0.5, truncated Newton,
-//! the convergence tests [`unamalla_core::pipeline::DEFAULT_STOP_RULES`]) against a
-//! *converged reference* — the same functional run with the window tests off, FTOL 10⁻¹²,
-//! the inner CG at its library default cap (200) and up to `MAXITER` iterations on the fine
-//! level (through the coarse levels, which only shorten the way to the same minimum).
+//! Time to quality on the sinusoidal TFI grid: the pipeline's smoother
+//! ([`unamalla_core::pipeline::default_smooth_options`]: [Méndez 2023, (6.8)] at σ = 0.5, truncated
+//! Newton, the convergence tests [`unamalla_core::pipeline::DEFAULT_STOP_RULES`]) against a
+//! *converged reference* — the same functional run with the window tests off, FTOL 10⁻¹², the inner
+//! CG at its library default cap (200) and up to `MAXITER` iterations on the fine level (through
+//! the coarse levels, which only shorten the way to the same minimum).
 //!
 //! `cargo run --release -p unamalla-core --example sinusoidal_quality -- N [MODE] [MAXITER]`
 //! * `N`: nodes per side (e.g. `1000`);

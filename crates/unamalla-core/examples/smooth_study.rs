@@ -1,4 +1,4 @@
-//! Smoothing candidates side by side (issue #23 item 3): every region is meshed once per
+//! Smoothing candidates side by side: every region is meshed once per
 //! candidate with the same pipeline and the table gives, per run, the global smoothing
 //! iterations (counted by the observer), the smooth stage's wall time, the process CPU time
 //! (user + sys, from `/proc/self/stat`), the μ ≥ 0.8 share, α₋/ᾱ and the status.

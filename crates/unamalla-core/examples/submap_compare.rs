@@ -1,4 +1,5 @@
-//! Submapping (seed 002) vs the default cut decomposition (seed 000) on the synthetic shapes of
+//! Submapping (Ruiz-Gironés & Sarrate) vs the default cut decomposition (Méndez 2023) on the
+//! synthetic shapes of
 //! `unamalla_decompose::submap::shapes`, printed as the Markdown table of `docs/results.md`
 //! (section "Submapping vs cuts").
 //!

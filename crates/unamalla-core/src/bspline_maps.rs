@@ -1,4 +1,4 @@
-//! B-spline maps of the blocks of a block-structured mesh (seed 003 digest §2, §3, §6 step 6).
+//! B-spline maps of the blocks of a block-structured mesh ([Abelló et al., §1.2–§1.3]).
 //!
 //! Every block of a [`BlockMesh2`] (e.g. [`MeshResult::mesh`] from the pipeline) is a structured
 //! `m × n` grid; its nodes are taken directly as a control net (node `(i, j)` ↦ `P_{i,j}`):

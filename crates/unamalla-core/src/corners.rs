@@ -1,4 +1,4 @@
-//! Automatic corner choice for a roughly four-sided ring (seed 000 digest §4.2, thesis §5.1.1).
+//! Automatic corner choice for a roughly four-sided ring ([Méndez 2023, §5.1.1]).
 //!
 //! The choice itself is the decomposition stage's corner selection
 //! ([`unamalla_decompose::select_corners`]: four non-reflex, non-flat vertices with balanced

@@ -73,7 +73,7 @@ pub struct CompatibleCounts {
 ///   is brought to `N` by rescaling `h ← h·√(C/N)` (cells scale like `h⁻²`) until
 ///   `|C/N − 1| ≤` [`BUDGET_TOLERANCE`] or [`BUDGET_ITERATIONS`] fits were run (the fit closest
 ///   to `N` is kept). Starts at `h = √(area/N)` or the given `h`.
-/// * [`MeshSize::Density`]`(d)`: problem (5.10) with the density bounds (seed 000 (5.9)).
+/// * [`MeshSize::Density`]`(d)`: problem (5.10) with the density bounds ([Méndez 2023, (5.9)]).
 pub fn compatible_counts(d: &Decomposition, size: MeshSize) -> Result<CompatibleCounts, CoreError> {
     let curves = BlockCurves::new(d);
     let problem = curves.problem();

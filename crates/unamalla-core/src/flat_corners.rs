@@ -6,7 +6,7 @@
 //! `#(nodes in one cell) − #(nodes in three cells) − 2·#(nodes in four cells) = 4`. A block
 //! corner on the region boundary is a node in one cell, so its cell has the region's interior
 //! angle there. A block that is a straight-sided triangle has only three corner-like vertices; the
-//! triangle-block rule of seed 000 digest §4.2 (our `unamalla-decompose`) therefore puts the
+//! triangle-block rule of [Méndez 2023, §5.1.1] (our `unamalla-decompose`) therefore puts the
 //! fourth corner at a point inserted on a straight edge, and the cell there has an angle of
 //! exactly 180° — three collinear, fixed nodes, a corner triangle with α = 0 that no smoothing
 //! of the interior can change (the cell is counted non-convex; its Jacobian vanishes at that

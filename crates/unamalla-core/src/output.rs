@@ -1,4 +1,4 @@
-//! Whole output sets or none (issue #24).
+//! Whole output sets or none (see `docs/reliability.md`).
 //!
 //! A run that writes several files must never leave a mixture behind: files of an older run
 //! that the new one does not write (stale `block-K.vts`), the first half of a set after a

@@ -1,4 +1,4 @@
-//! Predicted mesh quality of a block layout (issue #22): the acceptance criterion that chooses
+//! Predicted mesh quality of a block layout: the acceptance criterion that chooses
 //! between layouts.
 //!
 //! Admissibility (corner angles, convexity) says whether a block *can* be meshed; the

@@ -1,5 +1,5 @@
 //! Pictures of meshes: each cell coloured by the "rectangles 2015" measure μ, as in the thesis
-//! (seed 000 digest §1.4): blue μ ≥ 0.8, orange 0.4 ≤ μ < 0.8, red μ < 0.4 (non-convex cells
+//! ([Méndez 2023, §2.2]): blue μ ≥ 0.8, orange 0.4 ≤ μ < 0.8, red μ < 0.4 (non-convex cells
 //! have μ ≤ 0 and are red) — or, for a nodal field such as a PDE solution ([`field_png`],
 //! [`field_svg`]), by a continuous colour scale ([`field_color`]). SVG through
 //! [`unamalla_mesh::svg`], PNG rasterized with `tiny-skia` (pure Rust) and encoded by its PNG

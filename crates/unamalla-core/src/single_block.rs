@@ -2,7 +2,7 @@
 //!
 //! The outer ring is split at four corners into bottom, right, top and left sides; bottom/top
 //! are resampled with `m` points and left/right with `n` points equidistant in arc length
-//! (seed 000 digest §4.5); the interior is filled by the discrete Coons patch (§5.1). The
+//! ([Méndez 2023, §5.3]); the interior is filled by the discrete Coons patch (§6.1). The
 //! result may fold on strongly non-convex regions — that is what the optimizers are for; the
 //! quality report says so.
 

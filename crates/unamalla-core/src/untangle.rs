@@ -2,14 +2,13 @@
 //! sides) are untangled in small windows.
 //!
 //! Untangling a whole block with its boundary fixed spends its iterations on every cell of the
-//! block and cannot move the cut nodes a fold may need; untangling the whole merged mesh
-//! optimizes tens of thousands of cells to move a few hundred. This module does what an
-//! engineer would do by hand: take a **patch** — the folded cells and every cell within `r`
-//! layers of them (cells sharing a node count as neighbours) —
-//! across block boundaries, fix the nodes on the patch's border and on the region boundary,
-//! and run the untangling driver ([`unamalla_optim::smooth`], adaptive `k` of seed 001 digest
-//! §2.5 followed by (6.8)) on that small problem alone. The radius grows (`r = 2, 4, 8, 16, 32`
-//! by default) while folded cells remain.
+//! block and cannot move the cut nodes a fold may need; untangling the whole merged mesh optimizes
+//! tens of thousands of cells to move a few hundred. This module does what an engineer would do by
+//! hand: take a **patch** — the folded cells and every cell within `r` layers of them (cells
+//! sharing a node count as neighbours) — across block boundaries, fix the nodes on the patch's
+//! border and on the region boundary, and run the untangling driver ([`unamalla_optim::smooth`],
+//! adaptive `k` of [González Flores, Ch. 4] followed by [Méndez 2023, (6.8)]) on that small problem
+//! alone. The radius grows (`r = 2, 4, 8, 16, 32` by default) while folded cells remain.
 //!
 //! Guarantees: only nodes interior to a patch move, and a patch result is copied back only if
 //! it has no more non-convex cells than the patch had (the driver's own contract, checked
@@ -32,7 +31,7 @@
 //! ([`PatchReport::cancelled`]). Folds no patch could remove are listed in
 //! [`PatchReport::unresolved`].
 //!
-//! (Beyond the sources: seed 000 smooths block by block and then each block with its
+//! (Beyond the sources: [Méndez 2023, §6.3] smooths block by block and then each block with its
 //! neighbours; local windows around bad cells are standard practice in mesh untangling.)
 
 use rayon::prelude::*;

@@ -1,4 +1,5 @@
-//! Independent check of a finished mesh before success is reported (issue #24).
+//! Independent check of a finished mesh before success is reported (the guarantee holds or the
+//! run fails; see `docs/reliability.md`).
 //!
 //! The product's promise is an all-convex mesh of the region. The stages compute quality
 //! reports of their own, but a defect in a stage (a fold left by TFI of a wiggly block, a cell
@@ -9,7 +10,7 @@
 //! 1. **Convexity.** A quad `P₀P₁P₂P₃` is strictly convex iff all four corner triangles
 //!    `(P_{k−1}, P_k, P_{k+1})` are positively oriented,
 //!    `α_k = det(P_{k+1} − P_k, P_{k−1} − P_k)·(−1) > 0` (Ivanenko 1999, eq. (1.4): the
-//!    discrete Jacobian of each corner is positive; the same test as seed 001 digest §1). The
+//!    discrete Jacobian of each corner is positive; the same test as [González Flores, §4.1]). The
 //!    sign is decided exactly with Shewchuk's adaptive `orient2d` (Shewchuk 1997), so a
 //!    degenerate cell is never counted as convex by rounding.
 //! 2. **Cells inside the region.** Every cell centroid `c = ¼ΣP_k` must lie in the closed
@@ -28,8 +29,8 @@
 //!    edges, `F` the cells. It must equal the region's hole count (and `C` must be 1).
 //!
 //! [`verify_hexes`] applies the thesis's convexity test of hexahedra: the ten tetrahedra of
-//! [`unamalla_mesh::quality::hex::HEX_TETS`] (seed 004 digest §3.2, eq. 3.24) all of positive
-//! volume `V = (S − P)·((Q − P) × (R − P)) > 0`.
+//! [`unamalla_mesh::quality::hex::HEX_TETS`] ([Cortés Aguirre 2012, §3.2.1, (3.24)]) all of
+//! positive volume `V = (S − P)·((Q − P) × (R − P)) > 0`.
 
 use std::collections::HashMap;
 use std::fmt;
@@ -52,7 +53,7 @@ pub struct VerifyOptions {
 impl Default for VerifyOptions {
     /// `area_tolerance = 0.02` (2 %): the bundled regions meshed at 20,000 cells differ from
     /// the meshed (simplified) region by well below 1 % (chord error), while a dropped part or
-    /// a 4-cell mesh of a curved region (`--cells 0` before issue #24: 32 %) is far above.
+    /// a 4-cell mesh of a curved region (`--cells 0` used to give one: 32 %) is far above.
     fn default() -> Self {
         Self {
             area_tolerance: 0.02,

@@ -1,4 +1,4 @@
-//! The bad-input catalogue of issue #14 (`tests/bad_inputs/cases.json` at the repository
+//! The bad-input catalogue (`tests/bad_inputs/cases.json` at the repository
 //! root), checked at the library level: every case's reader returns the expected error
 //! **variant** (matched on the enums, see [`variant`]), or — for inputs that are valid though
 //! unusual ("ok", "ok:mesh") — is accepted and, for "ok:mesh", meshed by the default pipeline

@@ -1,4 +1,4 @@
-//! Issue #22: one regression test per shape category, each failing with the thesis's layout
+//! One regression test per shape category of block layouts, each failing with the thesis's layout
 //! alone (Algorithm 1, [`Layout::Concavity`]) and passing with the mesher's layout choice
 //! ([`choose_layout`]). The criteria are geometric, stated on the blocks, not on a file:
 //!

@@ -1,4 +1,4 @@
-//! Issue #22 item 3: `--cells N` gives N ± 15 % cells. Pipeline steps 1–6 (prepare, decompose,
+//! `--cells N` gives N ± 15 % cells. Pipeline steps 1–6 (prepare, decompose,
 //! compatible counts, TFI, merge) on bundled regions; smoothing moves nodes only, so the merged
 //! mesh has the final cell count. With the lower-bound counts of problem (5.10) these regions got
 //! 1.3–2.1× the request (docs/results.md, "Cell budget").

@@ -1,9 +1,9 @@
-//! Same input and options → byte-identical output files, at any thread count (issue #23
-//! item 2). The mesher runs twice in the default thread pool and once each in pools of 1 and
-//! 2 threads (what `RAYON_NUM_THREADS=1|2` gives the CLI); every run writes `mesh.msh` and the
-//! files must be equal byte for byte. Before the time budget was removed the smoothing stopped
-//! after 15 s of wall-clock time and two identical runs differed (hippo: μ ≥ 0.8 95.11 % vs
-//! 95.01 %); the parallel dot product also summed its chunk partials in rayon's order.
+//! Same input and options → byte-identical output files, at any thread count. The mesher runs twice
+//! in the default thread pool and once each in pools of 1 and 2 threads (what
+//! `RAYON_NUM_THREADS=1|2` gives the CLI); every run writes `mesh.msh` and the files must be equal
+//! byte for byte. Before the time budget was removed the smoothing stopped after 15 s of wall-clock
+//! time and two identical runs differed (hippo: μ ≥ 0.8 95.11 % vs 95.01 %); the parallel dot
+//! product also summed its chunk partials in rayon's order.
 
 use std::path::{Path, PathBuf};
 

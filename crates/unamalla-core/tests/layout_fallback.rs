@@ -1,4 +1,4 @@
-//! The layout fallback of `Mesher::mesh_observed` (issue #24: the guarantee holds or the run
+//! The layout fallback of `Mesher::mesh_observed` (the guarantee holds or the run
 //! fails — and a run should not fail where another candidate layout meets it).
 //!
 //! Newfoundland at 5,000 cells: the best-predicted layout (chords at aspect 0.35) has a block

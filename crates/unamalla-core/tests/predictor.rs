@@ -1,4 +1,4 @@
-//! Issue #22 item 2: the layout predictor ([`unamalla_core::predict`]) correlates with the
+//! The layout predictor ([`unamalla_core::predict`]) correlates with the
 //! quality the finished mesh reaches, block by block. `MeshReport::block_quality` holds both
 //! numbers per block; the cell-weighted Pearson correlation over the blocks of a real region
 //! must be clearly positive (≥ 0.5: the prediction explains at least a quarter of the

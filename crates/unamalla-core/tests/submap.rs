@@ -1,5 +1,6 @@
-//! End to end through the pipeline with the submapping strategy (seed 002) on the exact synthetic
-//! shapes of `unamalla_decompose::submap::shapes` (digest §9.2 stand-ins): every mesh is conformal,
+//! End to end through the pipeline with the submapping strategy ([Ruiz-Gironés & Sarrate]) on the
+//! exact synthetic shapes of `unamalla_decompose::submap::shapes` (stand-ins for the paper's
+//! figures, which give no coordinates): every mesh is conformal,
 //! all-convex after smoothing and free of interior singularities, and its blocks are the
 //! submapping's pieces.
 

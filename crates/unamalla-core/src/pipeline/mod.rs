@@ -1,6 +1,7 @@
 //! The end-to-end mesher: region → block-structured, singularity-free, all-convex quad mesh.
 //!
-//! Stages (seed 000 digest §0.1):
+//! Stages (after [Méndez 2023, §1.4, §1.5]; the references are listed in `docs/references.md` of
+//! the repository):
 //!
 //! 1. **simplify** the contour (`unamalla-contour`, default: modified areas, thesis threshold,
 //!    halved while the area changes by more than 1 %: [`simplify_for_mesh`]),
@@ -20,30 +21,30 @@
 //!    of `unamalla-compat-ilp` (every curve near `ℓ_j/h + 1` points, deviations paid in cells)
 //!    with `h` rescaled until the predicted cell count is within 2 % of the request (default
 //!    20 000 cells); for a density factor: the integer program (5.10) with the bounds (5.9);
-//! 4. **reparametrize** each curve by arc length with m_j points (§4.5) — a cut is resampled
+//! 4. **reparametrize** each curve by arc length with m_j points (§5.3) — a cut is resampled
 //!    once and both blocks use the same points;
-//! 5. **TFI** per block (§5.1);
+//! 5. **TFI** per block (§6.1);
 //! 6. **merge** into one conformal mesh without duplicate nodes ([`BlockMesh2::merge`]);
 //!    flat block corners on the region boundary (triangle blocks) are then bent outward by a
 //!    few degrees so their cells can be convex ([`crate::flat_corners`]);
-//! 7. **smooth** the merged mesh with `F = (1−σ)·w·F_AO + σ·H_ω` (seed 000 (6.8)/(6.9)) with the
-//!    ε-convexity guarantee of `unamalla-optim`; region boundary nodes are fixed, **cut nodes are
-//!    free**. The thesis smooths block by block and then each block with its neighbours. We
-//!    first untangle the folded cells in local patches of the merged mesh (the folded cells and
-//!    `r` layers around them, across block boundaries, `r` growing until they are convex;
-//!    patches in parallel, [`crate::untangle`]; small problems need far fewer iterations), then
-//!    run one global optimization over the whole merged mesh with the same functional (the limit
-//!    of the thesis's sequence), which starts convex wherever the patches could be untangled.
-//!    By default the start is not the TFI mesh but one prolonged from the same decomposition
-//!    meshed and smoothed with a quarter of the cells ([`crate::multilevel`], nested
-//!    iteration; [`Mesher::coarse_levels`]); the TFI start is kept when that one is not convex.
+//! 7. **smooth** the merged mesh with `F = (1−σ)·w·F_AO + σ·H_ω` ([Méndez 2023, (6.8), (6.9)]) with
+//!    the ε-convexity guarantee of `unamalla-optim`; region boundary nodes are fixed, **cut nodes
+//!    are free**. The thesis smooths block by block and then each block with its neighbours. We
+//!    first untangle the folded cells in local patches of the merged mesh (the folded cells and `r`
+//!    layers around them, across block boundaries, `r` growing until they are convex; patches in
+//!    parallel, [`crate::untangle`]; small problems need far fewer iterations), then run one global
+//!    optimization over the whole merged mesh with the same functional (the limit of the thesis's
+//!    sequence), which starts convex wherever the patches could be untangled. By default the start
+//!    is not the TFI mesh but one prolonged from the same decomposition meshed and smoothed with a
+//!    quarter of the cells ([`crate::multilevel`], nested iteration; [`Mesher::coarse_levels`]);
+//!    the TFI start is kept when that one is not convex.
 //! 8. **report** quality ([`QualityReport`]) and fidelity (area change, Hausdorff distance of
 //!    the mesh boundary to the input region).
 //!
 //! ## Decomposition strategies ([`Strategy`])
 //!
-//! * [`Strategy::Cuts`] (default): stages 2–6 as above (seed 000).
-//! * [`Strategy::Submap`]: stages 2–6 are replaced by **submapping** (seed 002,
+//! * [`Strategy::Cuts`] (default): stages 2–6 as above ([Méndez 2023, Ch. 4–6]).
+//! * [`Strategy::Submap`]: stages 2–6 are replaced by **submapping** ([Ruiz-Gironés & Sarrate],
 //!   [`unamalla_decompose::submap`]): vertex classification with the ILP (6)/(8) repair, virtual
 //!   edges for holes from a constrained Delaunay triangulation, edge classification, interval
 //!   assignment ILP (3), computational space, cuts from Corner/Reversal nodes, TFI per piece and
@@ -106,10 +107,10 @@ impl Default for MeshSize {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Strategy {
-    /// Straight cuts into admissible blocks with four corners (seed 000).
+    /// Straight cuts into admissible blocks with four corners ([Méndez 2023, Ch. 4]).
     #[default]
     Cuts,
-    /// Submapping (seed 002).
+    /// Submapping ([Ruiz-Gironés & Sarrate]).
     Submap,
     /// Submapping when all angles are near multiples of 90°, else cuts.
     Auto,
@@ -301,7 +302,7 @@ impl Mesher {
         self
     }
 
-    /// Boundary features whose modified-area measure ζ (seed 000 (3.4)) is below
+    /// Boundary features whose modified-area measure ζ ([Méndez 2023, (3.4)]) is below
     /// `c·h²` are removed after the contour simplification, `h` the target cell size
     /// (default [`DEFAULT_FEATURE_FACTOR`]; 0 disables; see
     /// [`unamalla_contour::remove_features_below`]). Not applied with `--density` sizes (no
@@ -441,20 +442,20 @@ impl Mesher {
 
 /// Weight σ of H_ω in the pipeline's smoothing functional (6.8), `(1 − σ)·F_AO + σ·H_ω`.
 ///
-/// The thesis's examples use σ = 0.1 (seed 000, the Laguna Honda region); the pipeline uses
-/// 0.5. Measured with the `smooth_study` example on the 34 development regions (docs/results.md,
-/// "Smoothing weight σ"): at σ = 0.1 the converged meshes of large open blocks whose cells are
-/// anisotropic (the compatible counts make them 1.5–2.5 times longer than wide) are **buckled**
-/// — grid lines in herringbone waves, with diagonal stripes of sheared cells (μ 0.6–0.8) a few
-/// cells apart — because the area–orthogonality term is nearly singular for diagonal shear
-/// waves (its Hessian's Rayleigh quotient is about `2θ⁴` for wave number θ, against `16θ²`
-/// for the other polarisation; the test `area_orthogonality_hessian_is_weak_for_diagonal_shear_waves`
-/// of `unamalla-functionals`) and H_ω at weight 0.1 does not hold them; running the σ = 0.1
-/// smoother to its FTOL (88 iterations instead of 51) does not remove the stripes. With
-/// σ = 0.5 the μ ≥ 0.8 share rose on **every** region at 5,000 cells (by 0.2–7 points; 22 → 26
-/// regions at ≥ 90 %) and at 20,000 cells (by 0.1–3.9 points; 30 → 33) with about half the
-/// iterations; σ = 0.3 and σ = 0.7 were close behind, σ = 1 (H_ω alone) lost on the
-/// silhouettes (crow 74.7 % at 5,000 cells).
+/// The thesis's examples use σ = 0.1 ([Méndez 2023, Example 6.3], the Laguna Honda region); the
+/// pipeline uses 0.5. Measured with the `smooth_study` example on the 34 development regions
+/// (docs/results.md, "Smoothing weight σ"): at σ = 0.1 the converged meshes of large open blocks
+/// whose cells are anisotropic (the compatible counts make them 1.5–2.5 times longer than wide) are
+/// **buckled** — grid lines in herringbone waves, with diagonal stripes of sheared cells (μ
+/// 0.6–0.8) a few cells apart — because the area–orthogonality term is nearly singular for diagonal
+/// shear waves (its Hessian's Rayleigh quotient is about `2θ⁴` for wave number θ, against `16θ²`
+/// for the other polarisation; the test
+/// `area_orthogonality_hessian_is_weak_for_diagonal_shear_waves` of `unamalla-functionals`) and H_ω
+/// at weight 0.1 does not hold them; running the σ = 0.1 smoother to its FTOL (88 iterations
+/// instead of 51) does not remove the stripes. With σ = 0.5 the μ ≥ 0.8 share rose on **every**
+/// region at 5,000 cells (by 0.2–7 points; 22 → 26 regions at ≥ 90 %) and at 20,000 cells (by
+/// 0.1–3.9 points; 30 → 33) with about half the iterations; σ = 0.3 and σ = 0.7 were close behind,
+/// σ = 1 (H_ω alone) lost on the silhouettes (crow 74.7 % at 5,000 cells).
 pub const DEFAULT_SIGMA: f64 = 0.5;
 
 /// The pipeline's smoothing defaults: (6.8) with σ = [`DEFAULT_SIGMA`] and truncated Newton

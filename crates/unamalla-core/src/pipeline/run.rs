@@ -337,20 +337,23 @@ impl Mesher {
         };
         lap(Stage::Simplify, &mut timer);
 
-        // 2–6 by submapping (seed 002) when the strategy asks for it
+        // 2–6 by submapping (Ruiz-Gironés & Sarrate) when the strategy asks for it
         // notes of step 3 for the report (cells the counts cannot avoid)
         let mut counts_notes: Vec<String> = Vec::new();
         let submapping = match (self.strategy, self.decomposition.is_some()) {
             (Strategy::Submap, true) => return Err(CoreError::DecompositionWithSubmap),
             (Strategy::Submap, false) => {
-                self.stage(Stage::Decompose, "submapping (seed 002)");
+                self.stage(Stage::Decompose, "submapping (Ruiz-Gironés & Sarrate)");
                 Some(submap(
                     &simplified,
                     &SubmapOptions::new(self.submap_size(&simplified)),
                 )?)
             }
             (Strategy::Auto, false) if prefers_submap(&simplified, AUTO_ANGLE_TOLERANCE_DEG) => {
-                self.stage(Stage::Decompose, "submapping (seed 002, automatic choice)");
+                self.stage(
+                    Stage::Decompose,
+                    "submapping (Ruiz-Gironés & Sarrate, automatic choice)",
+                );
                 submap(
                     &simplified,
                     &SubmapOptions::new(self.submap_size(&simplified)),
