@@ -1,12 +1,12 @@
 //! `unamalla bspline <region> --degree 1|2 --net NxM -o outdir`: B-spline parametrizations of a
-//! region with injectivity certificates (seed 003; crate `unamalla-bspline`).
+//! region with injectivity certificates ([Abelló et al.]; crate `unamalla-bspline`).
 //!
 //! How a region becomes control nets:
 //! * **default (one net)**: the region must be simply connected. Its outer ring is split at four
 //!   corners (automatic, as `unamalla tfi --auto-corners`, or `--corners a,b,c,d`) into south,
 //!   east, north and west sides; each side is resampled by arc length to `N` (south/north) or `M`
 //!   (west/east) points, which are used directly as the control points of the quadratic
-//!   boundary curves (digest §4 option (a)). The interior control points minimize
+//!   boundary curves (as `BoundaryCurves::from_ring`). The interior control points minimize
 //!   `½S_{ω,ε} + ½F_AO` from a TFI start; then the map of `--degree` is built and certified.
 //!   The region's boundary polygon is the control polygon Ω'; the biquadratic map's image is
 //!   bounded by the quadratic B-spline curves of that polygon.

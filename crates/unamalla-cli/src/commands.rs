@@ -18,8 +18,8 @@ use unamalla_core::output::{OutputDir, OutputFiles};
 use unamalla_core::pipeline::{Mesher, Strategy};
 use unamalla_core::OutputOptions;
 
-/// Input and export options of `unamalla mesh` (issue #26): region formats, feature
-/// selection, coordinate system, solver formats and the HTML report.
+/// Input and export options of `unamalla mesh` (see `docs/solvers-and-gis.md`): region formats,
+/// feature selection, coordinate system, solver formats and the HTML report.
 #[derive(clap::Args, Debug, Clone)]
 pub struct SolverGisArgs {
     /// Coordinate system of the region: auto (GeoJSON in the lon/lat range without declared
@@ -118,7 +118,8 @@ pub struct MeshArgs {
     /// together with --no-simplify) instead of the automatic one.
     #[arg(long)]
     pub decomposition: Option<PathBuf>,
-    /// Decomposition strategy: cuts (seed 000, default), submap (seed 002 submapping), or
+    /// Decomposition strategy: cuts (default; Méndez 2023), submap (submapping, Ruiz-Gironés &
+    /// Sarrate), or
     /// auto (submap when every angle is within 10° of a multiple of 90° and no vertex
     /// reclassification is needed, else cuts).
     #[arg(long, default_value = "cuts", value_parser = ["cuts", "submap", "auto"])]

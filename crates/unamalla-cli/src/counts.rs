@@ -2,8 +2,8 @@
 //! JSON [`CompatProblem`] (curves with lengths and optional pinned counts, blocks with four
 //! sides, cut pairs; the serde form of `unamalla_compat_ilp::CompatProblem`), and print or
 //! write the compatible point counts. An infeasible program (e.g. contradictory pins) is
-//! reported as one error line naming the conflicting constraints (seed 000 digest §4.3,
-//! erratum 8).
+//! reported as one error line naming the conflicting constraints ([Méndez 2023,
+//! §5.2.1]; equalities plus lower bounds can have no solution).
 
 use std::path::PathBuf;
 

@@ -188,15 +188,16 @@ enum Command {
     /// Compatible point counts of a compatibility problem (JSON), with pinned counts honoured.
     Counts(counts::CountsArgs),
     /// B-spline parametrization (bilinear or biquadratic) of a region from a convex control net,
-    /// with injectivity certificates and a dense det J sample (seed 003).
+    /// with injectivity certificates and a dense det J sample (Abelló et al.).
     Bspline(bspline::BsplineArgs),
     /// Structured hexahedral mesh of a built-in region or six face grids, made convex
-    /// (Algorithm A) with planar interior faces (Algorithm B) (seed 004).
+    /// (Algorithm A) with planar interior faces (Algorithm B) (Cortés Aguirre 2012).
     Hex(hex::HexArgs),
     /// Solve a·U_xx + 2b·U_xy + c·U_yy + d·U = g on a convex mesh (SOR or sparse LU); writes
-    /// VTK point data `u`, a Geomview MESH surface and PNG/SVG plots (seed 001 RF12).
+    /// VTK point data `u`, a Geomview MESH surface and PNG/SVG plots (González Flores, RF12).
     Pde(pde::PdeArgs),
-    /// Uniform refinement of a convex structured grid: every cell into k × k (seed 001 RF11).
+    /// Uniform refinement of a convex structured grid: every cell into k × k (González Flores,
+    /// RF11).
     Refine(refine::RefineArgs),
     /// Quality report of a mesh file: VTK legacy (.vtk), VTK XML (.vtu, .vts, .vtm: every block)
     /// or Gmsh (.msh).

@@ -1,5 +1,5 @@
-//! `unamalla refine`: uniform refinement of a convex structured grid (seed 001 digest §6 RF11,
-//! §7.3 *Refinement Control Panel*) by bilinear interpolation inside every cell
+//! `unamalla refine`: uniform refinement of a convex structured grid ([González Flores, §6.1.7,
+//! RF11; §A.4 *Refinement Control Panel*]) by bilinear interpolation inside every cell
 //! ([`StructuredGrid2::refined`](unamalla_core::mesh::StructuredGrid2::refined)): a factor `k`
 //! inserts `k − 1` lines between consecutive grid lines, so `m × n` nodes become
 //! `((m−1)k+1) × ((n−1)k+1)` and every cell is split into `k × k` convex cells.

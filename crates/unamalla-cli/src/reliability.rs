@@ -1,5 +1,5 @@
 //! Exit codes, argument checks, region parts and the guarantee check shared by the
-//! subcommands (issue #24).
+//! subcommands (the guarantee holds or the run fails; see `docs/reliability.md`).
 //!
 //! Exit codes (also in `--help` and docs/reliability.md):
 //!
