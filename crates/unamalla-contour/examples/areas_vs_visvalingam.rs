@@ -1,5 +1,5 @@
 //! Checks the thesis's statement that the modified area criterion removes more vertices than
-//! scaled Visvalingam at the same threshold (Méndez Cruz 2023, §3.3.4 and Tables 3.1–3.3:
+//! scaled Visvalingam at the same threshold ([Méndez 2023, §3.3.4, Tables 3.1–3.3]:
 //! octopus12 2015 vs 2011 at ε = 20, Presa La Amistad 8904 vs 8690 and Laguna Honda 2327 vs
 //! 1609 at ε = 1) on every region of `fixtures/regions`, and prints the Markdown table of
 //! docs/results.md ("Modified areas vs scaled Visvalingam").

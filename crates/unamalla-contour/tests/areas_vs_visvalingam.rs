@@ -1,5 +1,5 @@
-//! Modified areas vs scaled Visvalingam at the same ε (Méndez Cruz 2023, §3.1.1 and §3.3.4,
-//! (3.4)/(3.6)): both remove the vertex of smallest key while it is below `ε·ā` (`ā` the mean
+//! Modified areas vs scaled Visvalingam at the same ε ([Méndez 2023, §3.1.1, §3.3.4,
+//! (3.4), (3.6)]): both remove the vertex of smallest key while it is below `ε·ā` (`ā` the mean
 //! triangle area of the input ring); Visvalingam's key is the triangle area `a`, the modified
 //! one `ζ = 2a|sin θ|`. Neither removes more in general: right-angle vertices (`|sin θ| = 1`,
 //! `ζ = 2a`) are kept longer by the modified criterion, flat vertices (`|sin θ| < ½`) go

@@ -1,4 +1,4 @@
-//! The noise detector against the thesis's own noisy / clean examples (Méndez Cruz 2023,
+//! The noise detector against the thesis's own noisy / clean examples (Méndez 2023,
 //! *Parametrización de regiones poligonales complicadas*, §3.2.1 Fig 3.13, §3.2.2 Example 3.4
 //! and Figs 3.14–3.17), rebuilt from their descriptions: the images (MPEG-7 shapes `fork10`,
 //! `ray10`) are not in the text, so the shapes below are our own outlines with the properties
