@@ -1,5 +1,4 @@
-//! Rectilinear regions (Méndez Cruz 2023, *Generación de mallas estructuradas por bloques…*,
-//! Appendix B): the block-structured mesh as the image of a **rectilinear region** `R` — a
+//! Rectilinear regions ([Méndez 2023, Appendix B]): the block-structured mesh as the image of a **rectilinear region** `R` — a
 //! union of axis-parallel rectangles, one per block — under a piecewise-bilinear map
 //! `X : R → Ω`.
 //!
