@@ -12,7 +12,7 @@
 //! x_i ← (1/|N(i)|) Σ_{j ∈ N(i)} x_j      (N(i): the nodes sharing a cell edge with i)
 //! ```
 //!
-//! and measures the share of cells with μ ≥ 0.8 (μ of Oddy et al., 1988 as normalised in
+//! and measures the share of cells with μ ≥ 0.8 (the "rectangles 2015" μ of [Méndez 2023, §2.2],
 //! [`unamalla_mesh::quality::mu`]), overall and per block. A few Laplacian sweeps remove what
 //! the smoother removes easily (TFI's uneven spacing across a cut, kinks at cut ends) and keep
 //! what it cannot (a block whose corners sit at the tip of an arm, sheared slivers, a fine

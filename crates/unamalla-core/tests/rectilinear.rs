@@ -1,4 +1,4 @@
-//! Rectilinear regions (Méndez Cruz 2023, Appendix B) of pipeline meshes: on simply connected
+//! Rectilinear regions ([Méndez 2023, Appendix B]) of pipeline meshes: on simply connected
 //! regions the development of the blocks' index spaces is a rectilinear region `R` whose unit
 //! squares are exactly the mesh's cells (around a hole it need not close: the unit test
 //! `a_frame_of_trapezoids_does_not_close` in `unamalla_mesh::rectilinear`).
