@@ -1,5 +1,5 @@
 //! 2D functionals on quad meshes: [`QuadTopology`] (connectivity, free-variable map, fixed
-//! coordinates) and [`QuadFunctional`] (a topology plus a [`TriKernel`]), which implements
+//! coordinates) and [`QuadFunctional`] (a topology plus a [`KernelExpr`]), which implements
 //! [`Problem`].
 //!
 //! # The generic derivative path
@@ -29,9 +29,9 @@
 //! [`value_grad_reference`](QuadFunctional::value_grad_reference),
 //! [`hessian_reference`](QuadFunctional::hessian_reference) and
 //! [`hess_vec_reference`](QuadFunctional::hess_vec_reference) keep the per-triangle path above;
-//! the two agree to rounding (`tests/fast_path.rs`). A run-time [`Kernel2`] is flattened once
-//! ([`Kernel2::flattened`]); `w₁F_AO + w₂H_ω` (seed 000 (6.8)) then runs the monomorphized
-//! `Sum<AreaOrthogonality, HOmega>` kernel, anything else one `match` per cell and term.
+//! the two agree to rounding (`tests/fast_path.rs`). The kernel the fast path runs is chosen
+//! once per expression (private `plan` submodule): `w₁F_AO + w₂H_ω` (seed 000 (6.8)) runs a
+//! fused, monomorphized two-leaf kernel, anything else one `match` per cell and term.
 
 use std::sync::{Arc, OnceLock};
 
@@ -42,13 +42,13 @@ use unamalla_mesh::{FreeNodes, HasQuadCells};
 use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
 use crate::csr::Csr;
 use crate::error::FunctionalError;
-use crate::kernels2::{
-    AreaOrthogonality, CornerLanes, HOmega, Kernel2, LaneGrad, LanePartials, Order, Partials, Sum,
-    Terms, TriKernel, TriScalars,
-};
+use crate::kernel::{KernelExpr, Order, Partials, Terms, TriKernel, TriScalars};
 use crate::problem::{LocalModel, Problem};
 
 mod lanes;
+mod plan;
+
+use plan::Plan;
 
 /// Leg nodes `(n₀, n₁, n₂, n₃)` of corner `k` (`a = X_{n₁} − X_{n₀}`, `b = X_{n₃} − X_{n₂}`) and,
 /// at index 4, of the diagonal pair.
@@ -803,157 +803,19 @@ fn cell_hess<K: TriKernel>(
     v
 }
 
-/// A run-time [`Kernel2`] flattened to `Σ wᵢ Kᵢ` ([`Kernel2::flattened`]): one `match` per
-/// cell and term instead of one per corner triangle and nesting level.
-#[derive(Debug, Clone)]
-struct FlatKernel {
-    /// `(wᵢ, Kᵢ, Kᵢ uses corner triangles)`.
-    items: Vec<(f64, Kernel2, bool)>,
-    terms: Terms,
-    sparsity: [[bool; 4]; 4],
-}
-
-impl FlatKernel {
-    fn new(items: Vec<(f64, Kernel2)>) -> Self {
-        let mut terms = Terms {
-            corners: false,
-            diagonal: false,
-        };
-        let items = items
-            .into_iter()
-            .map(|(w, k)| {
-                let t = k.terms();
-                terms = terms.or(t);
-                (w, k, t.corners)
-            })
-            .collect::<Vec<_>>();
-        let sparsity = items.iter().fold([[false; 4]; 4], |m, (_, k, _)| {
-            crate::kernels2::sparsity_or(m, k.hessian_sparsity())
-        });
-        Self {
-            items,
-            terms,
-            sparsity,
-        }
-    }
-}
-
-impl TriKernel for FlatKernel {
-    fn eval(&self, s: &TriScalars, order: Order) -> Partials {
-        let mut p = Partials::default();
-        for (w, k, _) in &self.items {
-            let t = k.terms();
-            if (s.corner == crate::kernels2::DIAGONAL && t.diagonal)
-                || (s.corner != crate::kernels2::DIAGONAL && t.corners)
-            {
-                p.add_scaled(*w, &k.eval(s, order), order);
-            }
-        }
-        p
-    }
-    fn terms(&self) -> Terms {
-        self.terms
-    }
-    #[inline(always)]
-    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
-        self.sparsity
-    }
-    #[inline(always)]
-    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
-        let mut acc = [0.0; 4];
-        for (w, k, corners) in &self.items {
-            if *corners {
-                let v = k.corners_value(s);
-                for q in 0..4 {
-                    acc[q] += w * v[q];
-                }
-            }
-        }
-        acc
-    }
-    #[inline(always)]
-    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
-        let mut acc = LaneGrad::default();
-        for (w, k, corners) in &self.items {
-            if *corners {
-                acc.add_scaled(*w, &k.corners_value_grad(s));
-            }
-        }
-        acc
-    }
-    #[inline(always)]
-    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
-        let mut acc = LanePartials::default();
-        for (w, k, corners) in &self.items {
-            if *corners {
-                let m = k.hessian_sparsity();
-                acc.add_scaled_masked(*w, &k.corners_hessian(s), &m);
-            }
-        }
-        acc
-    }
-}
-
-/// How the fast path evaluates the kernel of a [`QuadFunctional`].
-#[derive(Debug, Clone)]
-enum Plan {
-    /// The kernel itself, monomorphized.
-    Own,
-    /// A run-time [`Kernel2`] that flattens to `w₁F_AO + w₂H_ω` (seed 000 (6.8)): evaluated by
-    /// the monomorphized fused kernel.
-    AoHOmega(Sum<AreaOrthogonality, HOmega>),
-    /// Any other run-time [`Kernel2`], flattened.
-    Flat(FlatKernel),
-}
-
-impl Plan {
-    fn for_kernel<K: TriKernel>(kernel: &K) -> Plan {
-        let Some(k2) = kernel.as_kernel2() else {
-            return Plan::Own;
-        };
-        let flat = k2.flattened();
-        if let [(w1, k1), (w2, k2)] = flat.as_slice() {
-            match (k1, k2) {
-                (Kernel2::AreaOrthogonality, Kernel2::HOmega(h)) => {
-                    return Plan::AoHOmega(Sum {
-                        wa: *w1,
-                        a: AreaOrthogonality,
-                        wb: *w2,
-                        b: *h,
-                    })
-                }
-                (Kernel2::HOmega(h), Kernel2::AreaOrthogonality) => {
-                    return Plan::AoHOmega(Sum {
-                        wa: *w2,
-                        a: AreaOrthogonality,
-                        wb: *w1,
-                        b: *h,
-                    })
-                }
-                _ => {}
-            }
-        }
-        Plan::Flat(FlatKernel::new(flat))
-    }
-}
-
-/// Runs `$body` with `$k` bound to the kernel the fast path uses (monomorphized per plan).
+/// Runs `$body` with `$k` bound to the kernel the fast path uses (monomorphized per plan) and
+/// `$t` to the leg pairs it needs.
 macro_rules! with_plan {
     ($self:expr, $k:ident, $t:ident => $body:expr) => {
         match &$self.plan {
-            Plan::Own => {
-                let $k = &$self.kernel;
-                let $t = $self.terms;
-                $body
-            }
             Plan::AoHOmega(kk) => {
                 let $k = kk;
                 let $t = kk.terms();
                 $body
             }
-            Plan::Flat(kk) => {
+            Plan::General(kk) => {
                 let $k = kk;
-                let $t = kk.terms;
+                let $t = $self.terms;
                 $body
             }
         }
@@ -963,24 +825,27 @@ macro_rules! with_plan {
 // After `with_plan!` (textual macro scope): the PSD-projected model Hessian (issue #4).
 pub mod psd;
 
-/// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a per-term kernel.
+/// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a [`KernelExpr`].
 ///
 /// [`Problem`] is implemented by the fast evaluator (module `lanes`: four corner lanes per cell,
-/// precomputed index and slot tables, AVX2 when available); the `*_reference` methods keep the
-/// straightforward per-triangle path, which the tests compare against.
+/// precomputed index and slot tables, AVX2 when available), running the plan chosen for the
+/// expression (module `plan`: a fused kernel for the sums it knows, a loop over the terms
+/// otherwise).
 #[derive(Debug, Clone)]
-pub struct QuadFunctional<K> {
+pub struct QuadFunctional {
     topo: Arc<QuadTopology>,
-    kernel: K,
+    kernel: KernelExpr,
     terms: Terms,
     plan: Plan,
 }
 
-impl<K: TriKernel> QuadFunctional<K> {
-    /// The functional `Σ kernel` over the leg pairs of the topology.
-    pub fn new(topo: Arc<QuadTopology>, kernel: K) -> Self {
+impl QuadFunctional {
+    /// The functional `Σ kernel` over the leg pairs of the topology (`kernel`: a
+    /// [`KernelExpr`], or anything that converts into one, e.g. a leaf kernel).
+    pub fn new(topo: Arc<QuadTopology>, kernel: impl Into<KernelExpr>) -> Self {
+        let kernel = kernel.into();
         let terms = kernel.terms();
-        let plan = Plan::for_kernel(&kernel);
+        let plan = Plan::for_expr(&kernel);
         Self {
             topo,
             kernel,
@@ -992,14 +857,15 @@ impl<K: TriKernel> QuadFunctional<K> {
     pub fn topology(&self) -> &Arc<QuadTopology> {
         &self.topo
     }
-    /// The kernel.
-    pub fn kernel(&self) -> &K {
+    /// The kernel expression.
+    pub fn kernel(&self) -> &KernelExpr {
         &self.kernel
     }
     /// Replaces the kernel (e.g. a new ω or k during a continuation), keeping the topology.
-    pub fn set_kernel(&mut self, kernel: K) {
+    pub fn set_kernel(&mut self, kernel: impl Into<KernelExpr>) {
+        let kernel = kernel.into();
         self.terms = kernel.terms();
-        self.plan = Plan::for_kernel(&kernel);
+        self.plan = Plan::for_expr(&kernel);
         self.kernel = kernel;
     }
     /// The value with a single-threaded loop (same chunked summation as [`Problem::value`], so
@@ -1018,6 +884,7 @@ impl<K: TriKernel> QuadFunctional<K> {
     /// Reference value: the per-triangle path with the kernel as given (no lanes, no
     /// flattening). Equal to [`Problem::value`] up to rounding.
     pub fn value_reference(&self, x: &[f64]) -> f64 {
+        let reference = plan::ExprKernel::new(&self.kernel);
         assert_eq!(
             x.len(),
             self.topo.num_vars(),
@@ -1025,13 +892,14 @@ impl<K: TriKernel> QuadFunctional<K> {
         );
         self.topo.asm.run_value(|c| {
             let (p, _) = self.topo.cell_points(x, c);
-            cell_value(&self.kernel, self.terms, &p, c)
+            cell_value(&reference, self.terms, &p, c)
         })
     }
 
     /// Reference value and gradient (per-triangle path, zero then add). Equal to
     /// [`Problem::value_grad`] up to rounding.
     pub fn value_grad_reference(&self, x: &[f64], g: &mut [f64]) -> f64 {
+        let reference = plan::ExprKernel::new(&self.kernel);
         assert_eq!(
             x.len(),
             self.topo.num_vars(),
@@ -1047,7 +915,7 @@ impl<K: TriKernel> QuadFunctional<K> {
         self.topo.asm.run_colored(|c| {
             let (p, vars) = self.topo.cell_points(x, c);
             let mut lg = [DVec2::ZERO; 4];
-            let v = cell_grad(&self.kernel, self.terms, &p, c, &mut lg);
+            let v = cell_grad(&reference, self.terms, &p, c, &mut lg);
             for i in 0..4 {
                 let j = vars[i];
                 if j != FIXED {
@@ -1070,7 +938,7 @@ impl<K: TriKernel> QuadFunctional<K> {
     /// As [`Problem::hessian`].
     pub fn hessian_reference(&self, x: &[f64], h: &mut Csr) {
         self.check_hessian_args(x, h);
-        self.hessian_generic(x, h);
+        self.hessian_per_triangle(&plan::ExprKernel::new(&self.kernel), self.terms, x, h);
     }
 
     fn check_hessian_args(&self, x: &[f64], h: &Csr) {
@@ -1090,11 +958,17 @@ impl<K: TriKernel> QuadFunctional<K> {
         );
     }
 
+    /// The per-triangle Hessian assembly with the plan's kernel (the fallback of
+    /// [`Problem::hessian`] when the slot tables cannot be built).
     fn hessian_generic(&self, x: &[f64], h: &mut Csr) {
+        with_plan!(self, k, t => self.hessian_per_triangle(k, t, x, h))
+    }
+
+    fn hessian_per_triangle<KK: TriKernel>(&self, k: &KK, t: Terms, x: &[f64], h: &mut Csr) {
         self.topo.assemble_cell_hessians(x, h, false, |c, p| {
             let mut lg = [DVec2::ZERO; 4];
             let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, p, c, &mut lg, &mut lh);
+            cell_hess(k, t, p, c, &mut lg, &mut lh);
             (lh, 0.0)
         });
     }
@@ -1102,6 +976,7 @@ impl<K: TriKernel> QuadFunctional<K> {
     /// Reference matrix-free Hessian-vector product (per-triangle 8×8 cell matrices). Equal to
     /// [`Problem::hess_vec`] up to rounding.
     pub fn hess_vec_reference(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+        let reference = plan::ExprKernel::new(&self.kernel);
         let n = self.topo.num_vars();
         assert_eq!(x.len(), n, "hess_vec: x has the wrong length");
         assert_eq!(v.len(), n, "hess_vec: v has the wrong length");
@@ -1112,7 +987,7 @@ impl<K: TriKernel> QuadFunctional<K> {
             let (p, vars) = self.topo.cell_points(x, c);
             let mut lg = [DVec2::ZERO; 4];
             let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, &p, c, &mut lg, &mut lh);
+            cell_hess(&reference, self.terms, &p, c, &mut lg, &mut lh);
             let mut lv = [0.0; 8];
             for i in 0..4 {
                 if vars[i] != FIXED {
@@ -1140,7 +1015,7 @@ impl<K: TriKernel> QuadFunctional<K> {
     }
 }
 
-impl<K: TriKernel> Problem for QuadFunctional<K> {
+impl Problem for QuadFunctional {
     fn dim(&self) -> usize {
         2
     }
@@ -1250,7 +1125,7 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels2::DIAGONAL;
+    use crate::kernel::DIAGONAL;
 
     #[test]
     fn diagonal_pair_gives_twice_the_cell_area() {
