@@ -79,6 +79,11 @@
 // Index loops mirror the component formulas of the derivatives (i, j, a, b as in the docs).
 #![allow(clippy::needless_range_loop)]
 
+// The unit tests that moved from `tests/` (they use the test-only reference path) name the
+// crate as its users do.
+#[cfg(test)]
+extern crate self as unamalla_functionals;
+
 pub mod assembly;
 pub mod csr;
 pub mod error;

@@ -1,10 +1,11 @@
 //! The fast evaluator (corner lanes, precomputed slots, first-contribution stores, the plan
 //! chosen for the `KernelExpr`, AVX2 dispatch) agrees with the reference per-triangle path
-//! (`QuadFunctional::*_reference`) to rounding — value, gradient, Hessian and Hessian-vector
+//! (`QuadFunctional::*_reference`, [`super`]) to rounding — value, gradient, Hessian and Hessian-vector
 //! product — on random convex and folded grids and on unstructured quad meshes, for every
 //! kind of kernel (fused, general, nested, custom, per-cell weighted, diagonal pair).
 #![allow(clippy::needless_range_loop)]
 
+#[path = "../../../tests/common/mod.rs"]
 mod common;
 
 use std::sync::Arc;
@@ -324,6 +325,8 @@ fn fast_path_is_bit_identical_across_thread_counts_on_a_multi_chunk_grid() {
         })
     };
     let one = run(1);
+    // the single-threaded loop with the same chunked summation gives the same value
+    assert_eq!(one.0, f.value_serial(&x).to_bits());
     assert!(one == run(2));
     assert!(one == run(3));
     // and the fast path agrees with the reference here too
