@@ -39,7 +39,7 @@ use unamalla_optim::monitor::{Control, Monitor, NullObserver, Session};
 use unamalla_optim::solver::{minimize, Solver, SolverOptions};
 use unamalla_optim::Preconditioner;
 
-type Winslow = QuadFunctional<Smoothness>;
+type Winslow = QuadFunctional;
 
 /// Iteration caps (outer iterations).
 const CAP_NEWTON: u64 = 300;

@@ -18,10 +18,10 @@
 //! triangles, which only conditions the numbers.
 //!
 //! Expressed with `unamalla-functionals`:
-//! `Scaled{1/N, Sum::convex(½, SOmegaEps(ω, ε, ᾱ, ScaleInvariant), Scaled{1/ᾱ², AreaOrthogonality})}`
-//! on the mesh's `QuadTopology`, minimized by `unamalla-optim` (truncated Newton with trust region
-//! by default — the paper used TN or L-BFGS-B) from the TFI start, which may be folded (`f` is
-//! finite for `α ≤ 0`). The optimizer's safeguard keeps a convex iterate convex.
+//! `1/N · (σ·SOmegaEps(ω, ε, ᾱ, ScaleInvariant) + (1−σ)·(1/ᾱ² · AreaOrthogonality))` as a
+//! [`KernelExpr`] built with `nested_sum` (the grouping evaluated as written), on the mesh's `QuadTopology`, minimized by `unamalla-optim` (truncated Newton with trust
+//! region by default — the paper used TN or L-BFGS-B) from the TFI start, which may be folded
+//! (`f` is finite for `α ≤ 0`). The optimizer's safeguard keeps a convex iterate convex.
 //!
 //! The paper does not report ω and ε. Defaults here (our choice): `ε = 0.05`, `ω = 20`. If the
 //! result is not ε-convex, ω is doubled and the minimization resumed from the current mesh ("ω
@@ -32,7 +32,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use unamalla_functionals::{
-    AreaOrthogonality, QuadFunctional, QuadTopology, SArgument, SOmegaEps, Scaled, Sum,
+    AreaOrthogonality, FunctionalError, KernelExpr, QuadFunctional, QuadTopology, SArgument,
+    SOmegaEps,
 };
 use unamalla_optim::monitor::{NullObserver, Session};
 use unamalla_optim::{minimize, SolverOptions, StopReason};
@@ -160,15 +161,17 @@ pub fn optimize_interior(
     for round in 0..=opts.omega_doublings {
         let s = SOmegaEps::new(omega, opts.eps, ab, SArgument::ScaleInvariant)
             .map_err(|e| BsplineError::Optimization(e.to_string()))?;
-        let ao = Scaled {
-            factor: 1.0 / (ab * ab),
-            inner: AreaOrthogonality,
-        };
-        let kernel = Scaled {
-            factor: 1.0 / ntri,
-            inner: Sum::convex(opts.sigma, s, ao)
-                .map_err(|e| BsplineError::Optimization(e.to_string()))?,
-        };
+        if !(0.0..=1.0).contains(&opts.sigma) {
+            let e = FunctionalError::InvalidParameter {
+                name: "sigma",
+                value: opts.sigma,
+                reason: "a convex combination needs 0 ≤ σ ≤ 1".into(),
+            };
+            return Err(BsplineError::Optimization(e.to_string()));
+        }
+        let ao = KernelExpr::nested_sum([(1.0 / (ab * ab), AreaOrthogonality.into())]);
+        let sum = KernelExpr::nested_sum([(opts.sigma, s.into()), (1.0 - opts.sigma, ao)]);
+        let kernel = KernelExpr::nested_sum([(1.0 / ntri, sum)]);
         let problem = QuadFunctional::new(topo.clone(), kernel);
         let mut session = Session::new(&problem, &x, &mut observer);
         let r = minimize(&problem, &mut x, &opts.solver, &mut session)

@@ -74,10 +74,13 @@ fn bench_2d(c: &mut Criterion) {
         let g = quad_grid(cells);
         let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
         let abar = topo.alpha_bar();
-        let f = QuadFunctional::new(
-            topo.clone(),
-            Sum::convex(0.9, AreaOrthogonality, HOmega::new(0.5 * abar).unwrap()).unwrap(),
-        );
+        let sum = KernelExpr::convex(
+            0.9,
+            AreaOrthogonality.into(),
+            HOmega::new(0.5 * abar).unwrap().into(),
+        )
+        .unwrap();
+        let f = QuadFunctional::new(topo.clone(), sum.clone());
         let x = topo.initial_x();
         let mut grad = vec![0.0; f.num_vars()];
         group.throughput(Throughput::Elements(topo.num_triangles() as u64));
@@ -85,16 +88,8 @@ fn bench_2d(c: &mut Criterion) {
             b.iter(|| f.value_grad(&x, &mut grad))
         });
         if cells == 1000 {
-            // the run-time assembled kernel on the same functional, for comparison
-            let fd = QuadFunctional::new(
-                topo.clone(),
-                Kernel2::convex(
-                    0.9,
-                    Kernel2::AreaOrthogonality,
-                    Kernel2::HOmega(HOmega::new(0.5 * abar).unwrap()),
-                )
-                .unwrap(),
-            );
+            // the general (not fused) plan on the same functional, for comparison
+            let fd = QuadFunctional::new(topo.clone(), KernelExpr::nested_sum([(1.0, sum)]));
             group.bench_with_input(BenchmarkId::new("value_grad_dyn", cells), &cells, |b, _| {
                 b.iter(|| fd.value_grad(&x, &mut grad))
             });

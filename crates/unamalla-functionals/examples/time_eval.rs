@@ -1,7 +1,7 @@
 //! Timing of `0.9·F_AO + 0.1·H_ω` (seed 000 (6.8), σ = 0.1, ω = ᾱ/2) on an `n × n`-cell grid:
-//! value + gradient, Hessian refresh, matrix-free Hessian-vector product and CSR SpMV, for the
-//! typed kernel (`Sum<AreaOrthogonality, HOmega>`) and the run-time `Kernel2` combination, plus
-//! the reference (per-triangle) path for comparison.
+//! value + gradient, Hessian refresh, matrix-free Hessian-vector product and CSR SpMV, with the
+//! evaluator's fused plan (`KernelExpr::convex(0.9, F_AO, H_ω)`) and, for comparison, the general
+//! plan (the same sum wrapped in a one-part `nested_sum`, which the evaluator does not fuse).
 //!
 //! ```text
 //! cargo run --release -p unamalla-functionals --example time_eval -- [cells=1000] [reps=10]
@@ -66,14 +66,9 @@ fn main() {
     let topo = Arc::new(QuadTopology::from_mesh(&g).expect("valid mesh"));
     let abar = topo.alpha_bar();
     let homega = HOmega::new(0.5 * abar).expect("ω > 0");
-    let f = QuadFunctional::new(
-        topo.clone(),
-        Sum::convex(0.9, AreaOrthogonality, homega).expect("σ"),
-    );
-    let fd = QuadFunctional::new(
-        topo.clone(),
-        Kernel2::convex(0.9, Kernel2::AreaOrthogonality, Kernel2::HOmega(homega)).expect("σ"),
-    );
+    let sum = KernelExpr::convex(0.9, AreaOrthogonality.into(), homega.into()).expect("σ");
+    let f = QuadFunctional::new(topo.clone(), sum.clone());
+    let fd = QuadFunctional::new(topo.clone(), KernelExpr::nested_sum([(1.0, sum)]));
     let x = topo.initial_x();
     let n = f.num_vars();
     let mut grad = vec![0.0; n];
@@ -93,30 +88,22 @@ fn main() {
     };
     let mut v = 0.0;
     report(
-        "value_grad (typed)",
+        "value_grad (fused)",
         time(reps, || v = f.value_grad(&x, &mut grad)),
     );
     report(
-        "value_grad (Kernel2)",
+        "value_grad (general)",
         time(reps, || v = fd.value_grad(&x, &mut grad)),
     );
-    report(
-        "value_grad (reference)",
-        time(reps.min(5), || v = f.value_grad_reference(&x, &mut grad)),
-    );
-    report("value (typed)", time(reps, || v = f.value(&x)));
+    report("value (fused)", time(reps, || v = f.value(&x)));
     let mut hm = f.hessian_pattern();
     report(
-        "hessian refresh (typed)",
+        "hessian refresh (fused)",
         time(reps, || f.hessian(&x, &mut hm)),
     );
     report(
-        "hessian refresh (Kernel2)",
+        "hessian refresh (general)",
         time(reps, || fd.hessian(&x, &mut hm)),
-    );
-    report(
-        "hessian refresh (reference)",
-        time(reps.min(3), || f.hessian_reference(&x, &mut hm)),
     );
     report(
         "hess_vec matrix-free",

@@ -370,7 +370,9 @@ impl<const K: usize> Assembly<K> {
         guard.iter().sum()
     }
 
-    /// Serial form of [`run_value_chunks`](Self::run_value_chunks) (same sums, same order).
+    /// Serial form of [`run_value_chunks`](Self::run_value_chunks) (same sums, same order): the
+    /// tests' check that the parallel value does not depend on the thread count.
+    #[cfg(test)]
     pub(crate) fn run_serial_chunks<F>(&self, per_chunk: F) -> f64
     where
         F: Fn(usize, usize) -> f64,

@@ -22,7 +22,7 @@
 //! | `regularized-inverse-area` | `φ̃(α)` with `ε_c = ᾱ/2` |
 //!
 //! Without `--raw` the functional is normalized to 1 on the ideal grid
-//! ([`Kernel2::normalized`]). The gradient norm is the Euclidean norm of the gradient with
+//! ([`KernelExpr::normalized`]). The gradient norm is the Euclidean norm of the gradient with
 //! respect to the free-node coordinates. Defaults: `k = 0`, `ω = ᾱ/2` (reported back in
 //! [`EvalReport`]).
 
@@ -32,8 +32,9 @@ use serde::Serialize;
 use unamalla_mesh::{FreeNodes, HasQuadCells};
 
 use crate::error::FunctionalError;
-use crate::kernels2::{
-    HOmega, KArea, KSmoothness, Kernel2, RegularizedInverseArea, RegularizedSmoothness, A4P,
+use crate::kernel::{
+    Area, AreaOrthogonality, CastilloArea, HOmega, KArea, KSmoothness, KernelExpr, Length,
+    Orthogonality, RegularizedInverseArea, RegularizedSmoothness, Smoothness, A4P,
 };
 use crate::problem::Problem;
 use crate::quad::{QuadFunctional, QuadTopology};
@@ -160,29 +161,28 @@ impl FunctionalSpec {
 
     /// The raw (un-normalized) kernel for a mesh with mean `ᾱ = alpha_bar`, and the resolved
     /// `ω` (for `h-omega`).
-    pub fn raw_kernel(&self, alpha_bar: f64) -> Result<(Kernel2, Option<f64>), FunctionalError> {
+    pub fn raw_kernel(&self, alpha_bar: f64) -> Result<(KernelExpr, Option<f64>), FunctionalError> {
         Ok(match self {
-            Self::Length => (Kernel2::Length, None),
-            Self::Area => (Kernel2::Area, None),
-            Self::Orthogonality => (Kernel2::Orthogonality, None),
-            Self::AreaOrthogonality => (Kernel2::AreaOrthogonality, None),
-            Self::Smoothness => (Kernel2::Smoothness(Default::default()), None),
-            Self::KSmoothness { k } => (Kernel2::KSmoothness(KSmoothness::new(*k, None)?), None),
-            Self::KArea { k } => (Kernel2::KArea(KArea::new(*k, None)?), None),
+            Self::Length => (Length.into(), None),
+            Self::Area => (Area.into(), None),
+            Self::Orthogonality => (Orthogonality.into(), None),
+            Self::AreaOrthogonality => (AreaOrthogonality.into(), None),
+            Self::Smoothness => (Smoothness::new().into(), None),
+            Self::KSmoothness { k } => (KSmoothness::new(*k, None)?.into(), None),
+            Self::KArea { k } => (KArea::new(*k, None)?.into(), None),
             Self::HOmega { omega } => {
                 let w = omega.unwrap_or(0.5 * alpha_bar);
-                (Kernel2::HOmega(HOmega::new(w)?), Some(w))
+                (HOmega::new(w)?.into(), Some(w))
             }
-            Self::A4P => (Kernel2::A4P(A4P::new(alpha_bar)?), None),
-            Self::CastilloArea => (Kernel2::CastilloArea, None),
+            Self::A4P => (A4P::new(alpha_bar)?.into(), None),
+            Self::CastilloArea => (CastilloArea.into(), None),
             Self::RegularizedSmoothness => (
-                Kernel2::RegularizedSmoothness(RegularizedSmoothness::with_alpha_bar(alpha_bar)?),
+                RegularizedSmoothness::with_alpha_bar(alpha_bar)?.into(),
                 None,
             ),
-            Self::RegularizedInverseArea => (
-                Kernel2::RegularizedInverseArea(RegularizedInverseArea::new(0.5 * alpha_bar)?),
-                None,
-            ),
+            Self::RegularizedInverseArea => {
+                (RegularizedInverseArea::new(0.5 * alpha_bar)?.into(), None)
+            }
         })
     }
 }

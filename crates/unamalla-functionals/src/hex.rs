@@ -56,7 +56,7 @@ use unamalla_mesh::{FreeNodes, HasHexCells};
 use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
 use crate::csr::Csr;
 use crate::error::FunctionalError;
-use crate::kernels2::phi_omega;
+use crate::kernel::phi_omega;
 use crate::problem::{LocalModel, Problem};
 
 /// The six faces of a hexahedron (0-based VTK indices) in the seed 004 order

@@ -13,7 +13,7 @@
 //! `α = det(a, b)` (doubled signed area), `l = |a|² + |b|²`, `o = a·b`
 //! (seed 000 digest §5.5 Table 6.2 and Fig 6.12; seed 001 digest §1). A cell is convex iff its
 //! four α are positive; `Σα = 4·area(Ω)`, `ᾱ = Σα/N`. A functional is `F = Σ_q f(α_q, l_q, o_q)`
-//! ([`kernels2`]):
+//! with `f` a weighted sum of the leaf kernels below ([`kernel`]):
 //!
 //! | kernel | term | source |
 //! |---|---|---|
@@ -33,19 +33,23 @@
 //! | [`HOmega`] | `l·φ_ω(α)`, `φ_ω = 1/α` (α ≥ ω), `(2ω − α)/ω²` below (C¹) | seed 000 §5.5, erratum 10 |
 //! | [`IvanenkoConvex`] | `((ε − α)₊)²` (zero iff every `α ≥ ε`) | González Flores, UNAMALLA thesis, §2.2 (2.50), after Ivanenko |
 //!
-//! plus normalizations ([`Kernel2::normalized`], seed 001 §3.1), weighted sums ([`Sum`],
-//! [`Kernel2::Combination`], e.g. seed 000 (6.8) `(1−σ)F_AO + σH_ω`) and per-cell weights
-//! ([`CellWeighted`], the boundary density `w` of seed 000 (6.9)).
+//! Every leaf is a variant of [`Leaf`] (the leaf list is written once, in [`kernel::expr`]).
+//! A functional is one [`KernelExpr`], a weighted sum of (possibly cell-weighted) leaves:
+//! `f = Σᵢ wᵢ·Eᵢ` with each `Eᵢ` a leaf `fᵢ` or `c(cell)·E` (per-cell weights `c`, the boundary
+//! density `w` of seed 000 (6.9)), built with normalizations ([`KernelExpr::normalized`], `F/(N·f(ideal triangle))`, seed 001
+//! §3.1), weighted sums ([`KernelExpr::weighted_sum`], [`KernelExpr::convex`], e.g. seed 000
+//! (6.8) `(1−σ)F_AO + σH_ω`) and per-cell weights ([`KernelExpr::cell_weighted`]). User
+//! kernels implement [`TriKernel`] and enter as [`Leaf::Custom`] (e.g. a [`GenericArea`]).
 //!
 //! Gradients and Hessians come from one generic chain rule through `(α, |a|², |b|², o)`
 //! (formulas in [`quad`]). The evaluator computes the four corner triangles of a cell together
 //! as four SIMD lanes ([`TriKernel::corners_value_grad`], [`CornerLanes`]), reuses the squared
 //! edge lengths shared by two corners, skips the structurally zero second partials
 //! ([`TriKernel::hessian_sparsity`]), writes gradients and Hessian blocks at precomputed
-//! positions without a zeroing pass, routes run-time [`Kernel2`] sums to monomorphized fused
-//! kernels ([`Kernel2::flattened`]) and uses AVX2 when the CPU has it (bit-identical results);
-//! the straightforward per-triangle path stays available as `QuadFunctional::*_reference` and
-//! the tests check that both agree.
+//! positions without a zeroing pass, and uses AVX2 when the CPU has it (bit-identical results).
+//! It inspects the expression once and runs a fused, monomorphized kernel for the sums it knows
+//! (`w₁F_AO + w₂H_ω`), a loop over the terms otherwise; both do the same arithmetic in the same
+//! order. The tests keep a straightforward per-triangle path and check that both agree.
 //!
 //! ## 3D: hexahedra
 //! [`HexFunctional`] ([`hex`]): the quasi-harmonic `H_ω` over the 10 tetrahedra of each
@@ -74,12 +78,17 @@
 // Index loops mirror the component formulas of the derivatives (i, j, a, b as in the docs).
 #![allow(clippy::needless_range_loop)]
 
+// The unit tests that moved from `tests/` (they use the test-only reference path) name the
+// crate as its users do.
+#[cfg(test)]
+extern crate self as unamalla_functionals;
+
 pub mod assembly;
 pub mod csr;
 pub mod error;
 pub mod eval;
 pub mod hex;
-pub mod kernels2;
+pub mod kernel;
 #[cfg(feature = "nalgebra-sparse")]
 pub mod nalgebra_sparse_conv;
 pub mod problem;
@@ -92,12 +101,12 @@ pub use hex::{
     energy_variants, face_coplanarity_cos, face_planarity_max_cos, hex_tets, EnergyVariants,
     HexFunctional, HexTopology, Scaling3, Tet, HEX_QUAD_FACES,
 };
-pub use kernels2::{
+pub use kernel::{
     inv_k, phi_omega, phi_regularized, recommended_alpha_hat, s_function, Area, AreaOrthogonality,
-    CastilloArea, CellWeighted, CornerLanes, GenericArea, HOmega, IvanenkoConvex, KArea,
-    KSmoothness, Kernel2, LaneGrad, LanePartials, Length, Order, Orthogonality, Partials,
-    RegularizedInverseArea, RegularizedSmoothness, SArgument, SOmegaEps, Scaled, Smoothness,
-    SpacingWeights, Sum, Terms, TriKernel, TriScalars, WeightedLength, A4P,
+    CastilloArea, CornerLanes, GenericArea, HOmega, IvanenkoConvex, KArea, KSmoothness, KernelExpr,
+    LaneGrad, LanePartials, Leaf, Length, Order, Orthogonality, Partials, RegularizedInverseArea,
+    RegularizedSmoothness, SArgument, SOmegaEps, Smoothness, SpacingWeights, Terms, TriKernel,
+    TriScalars, WeightedLength, A4P,
 };
 #[cfg(feature = "nalgebra-sparse")]
 pub use nalgebra_sparse_conv::CsrConversionError;

@@ -1,5 +1,5 @@
 //! 2D functionals on quad meshes: [`QuadTopology`] (connectivity, free-variable map, fixed
-//! coordinates) and [`QuadFunctional`] (a topology plus a [`TriKernel`]), which implements
+//! coordinates) and [`QuadFunctional`] (a topology plus a [`KernelExpr`]), which implements
 //! [`Problem`].
 //!
 //! # The generic derivative path
@@ -24,14 +24,12 @@
 //! (the four corners of a cell as SIMD lanes, per-cell first-contribution flags and CSR slot
 //! tables, AVX2 dispatch; its docs give the node-block formulas `H_PP = A + B + Bᵀ + C`,
 //! `H_PQ = −(A + Bᵀ)`, `H_PR = −(B + C)`, `H_QR = B` of a corner with leg blocks
-//! `A = H_aa`, `B = H_ab`, `C = H_bb`). The methods
-//! [`value_reference`](QuadFunctional::value_reference),
-//! [`value_grad_reference`](QuadFunctional::value_grad_reference),
-//! [`hessian_reference`](QuadFunctional::hessian_reference) and
-//! [`hess_vec_reference`](QuadFunctional::hess_vec_reference) keep the per-triangle path above;
-//! the two agree to rounding (`tests/fast_path.rs`). A run-time [`Kernel2`] is flattened once
-//! ([`Kernel2::flattened`]); `w₁F_AO + w₂H_ω` (seed 000 (6.8)) then runs the monomorphized
-//! `Sum<AreaOrthogonality, HOmega>` kernel, anything else one `match` per cell and term.
+//! `A = H_aa`, `B = H_ab`, `C = H_bb`). The per-triangle path above is kept in a test-only
+//! submodule (`reference`) as the oracle: the tests check that the two agree to rounding for
+//! every kind of expression. The kernel the fast path runs is chosen once per expression
+//! (private `plan` submodule): `w₁F_AO + w₂H_ω` (seed 000 (6.8)) runs a fused, monomorphized
+//! two-leaf kernel, anything else the expression's own evaluation (one `match` per node, cell
+//! and term).
 
 use std::sync::{Arc, OnceLock};
 
@@ -42,13 +40,13 @@ use unamalla_mesh::{FreeNodes, HasQuadCells};
 use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
 use crate::csr::Csr;
 use crate::error::FunctionalError;
-use crate::kernels2::{
-    AreaOrthogonality, CornerLanes, HOmega, Kernel2, LaneGrad, LanePartials, Order, Partials, Sum,
-    Terms, TriKernel, TriScalars,
-};
+use crate::kernel::{KernelExpr, Order, Partials, Terms, TriKernel, TriScalars};
 use crate::problem::{LocalModel, Problem};
 
 mod lanes;
+mod plan;
+
+use plan::Plan;
 
 /// Leg nodes `(n₀, n₁, n₂, n₃)` of corner `k` (`a = X_{n₁} − X_{n₀}`, `b = X_{n₃} − X_{n₂}`) and,
 /// at index 4, of the diagonal pair.
@@ -685,95 +683,11 @@ fn pair_range(t: Terms) -> (usize, usize) {
     }
 }
 
-/// Corner-triangle scalars from the cell edges `e_k = v_{k+1} − v_k`: at corner `k`,
-/// `a = e_k`, `b = −e_{k−1}` (bitwise identical to `v_{k−1} − v_k`).
-#[inline(always)]
-fn corner_from_edges(
-    e: &[DVec2; 4],
-    l2: &[f64; 4],
-    c: usize,
-    k: usize,
-) -> (DVec2, DVec2, TriScalars) {
-    let km = (k + 3) & 3;
-    let a = e[k];
-    let b = -e[km];
-    (
-        a,
-        b,
-        TriScalars {
-            alpha: a.perp_dot(b),
-            la: l2[k],
-            lb: l2[km],
-            o: a.dot(b),
-            cell: c,
-            corner: k as u8,
-        },
-    )
-}
-
-#[inline(always)]
-fn edges(p: &[DVec2; 4]) -> ([DVec2; 4], [f64; 4]) {
-    let e = [p[1] - p[0], p[2] - p[1], p[3] - p[2], p[0] - p[3]];
-    (e, e.map(|v| v.length_squared()))
-}
-
-#[inline(always)]
-fn cell_value<K: TriKernel>(k: &K, t: Terms, p: &[DVec2; 4], c: usize) -> f64 {
-    let mut v = 0.0;
-    if t.corners {
-        let (e, l2) = edges(p);
-        for q in 0..4 {
-            let (_, _, s) = corner_from_edges(&e, &l2, c, q);
-            v += k.value(&s);
-        }
-    }
-    if t.diagonal {
-        let (_, _, s) = scalars(p, c, 4);
-        v += k.value(&s);
-    }
-    v
-}
-
 #[inline(always)]
 fn leg_grads(a: DVec2, b: DVec2, d: &[f64; 4]) -> (DVec2, DVec2) {
     let ga = d[0] * DVec2::new(b.y, -b.x) + (2.0 * d[1]) * a + d[3] * b;
     let gb = d[0] * DVec2::new(-a.y, a.x) + (2.0 * d[2]) * b + d[3] * a;
     (ga, gb)
-}
-
-/// Value and gradient of the terms of cell `c` (corner terms accumulated per edge, then per
-/// node: `e_k = v_{k+1} − v_k` gives `+∂f/∂e_k` to `v_{k+1}` and `−∂f/∂e_k` to `v_k`).
-#[inline(always)]
-fn cell_grad<K: TriKernel>(k: &K, t: Terms, p: &[DVec2; 4], c: usize, g: &mut [DVec2; 4]) -> f64 {
-    let mut v = 0.0;
-    if t.corners {
-        let (e, l2) = edges(p);
-        let mut ge = [DVec2::ZERO; 4];
-        for q in 0..4 {
-            let (a, b, s) = corner_from_edges(&e, &l2, c, q);
-            let (val, dg) = k.value_grad(&s);
-            v += val;
-            let (ga, gb) = leg_grads(a, b, &dg);
-            ge[q] += ga;
-            ge[(q + 3) & 3] -= gb;
-        }
-        for q in 0..4 {
-            g[(q + 1) & 3] += ge[q];
-            g[q] -= ge[q];
-        }
-    }
-    if t.diagonal {
-        let (a, b, s) = scalars(p, c, 4);
-        let (val, dg) = k.value_grad(&s);
-        v += val;
-        let (ga, gb) = leg_grads(a, b, &dg);
-        let l = LEGS[4];
-        g[l[1]] += ga;
-        g[l[0]] -= ga;
-        g[l[3]] += gb;
-        g[l[2]] -= gb;
-    }
-    v
 }
 
 /// Value, gradient and 8×8 Hessian of the terms of cell `c`.
@@ -803,157 +717,19 @@ fn cell_hess<K: TriKernel>(
     v
 }
 
-/// A run-time [`Kernel2`] flattened to `Σ wᵢ Kᵢ` ([`Kernel2::flattened`]): one `match` per
-/// cell and term instead of one per corner triangle and nesting level.
-#[derive(Debug, Clone)]
-struct FlatKernel {
-    /// `(wᵢ, Kᵢ, Kᵢ uses corner triangles)`.
-    items: Vec<(f64, Kernel2, bool)>,
-    terms: Terms,
-    sparsity: [[bool; 4]; 4],
-}
-
-impl FlatKernel {
-    fn new(items: Vec<(f64, Kernel2)>) -> Self {
-        let mut terms = Terms {
-            corners: false,
-            diagonal: false,
-        };
-        let items = items
-            .into_iter()
-            .map(|(w, k)| {
-                let t = k.terms();
-                terms = terms.or(t);
-                (w, k, t.corners)
-            })
-            .collect::<Vec<_>>();
-        let sparsity = items.iter().fold([[false; 4]; 4], |m, (_, k, _)| {
-            crate::kernels2::sparsity_or(m, k.hessian_sparsity())
-        });
-        Self {
-            items,
-            terms,
-            sparsity,
-        }
-    }
-}
-
-impl TriKernel for FlatKernel {
-    fn eval(&self, s: &TriScalars, order: Order) -> Partials {
-        let mut p = Partials::default();
-        for (w, k, _) in &self.items {
-            let t = k.terms();
-            if (s.corner == crate::kernels2::DIAGONAL && t.diagonal)
-                || (s.corner != crate::kernels2::DIAGONAL && t.corners)
-            {
-                p.add_scaled(*w, &k.eval(s, order), order);
-            }
-        }
-        p
-    }
-    fn terms(&self) -> Terms {
-        self.terms
-    }
-    #[inline(always)]
-    fn hessian_sparsity(&self) -> [[bool; 4]; 4] {
-        self.sparsity
-    }
-    #[inline(always)]
-    fn corners_value(&self, s: &CornerLanes) -> [f64; 4] {
-        let mut acc = [0.0; 4];
-        for (w, k, corners) in &self.items {
-            if *corners {
-                let v = k.corners_value(s);
-                for q in 0..4 {
-                    acc[q] += w * v[q];
-                }
-            }
-        }
-        acc
-    }
-    #[inline(always)]
-    fn corners_value_grad(&self, s: &CornerLanes) -> LaneGrad {
-        let mut acc = LaneGrad::default();
-        for (w, k, corners) in &self.items {
-            if *corners {
-                acc.add_scaled(*w, &k.corners_value_grad(s));
-            }
-        }
-        acc
-    }
-    #[inline(always)]
-    fn corners_hessian(&self, s: &CornerLanes) -> LanePartials {
-        let mut acc = LanePartials::default();
-        for (w, k, corners) in &self.items {
-            if *corners {
-                let m = k.hessian_sparsity();
-                acc.add_scaled_masked(*w, &k.corners_hessian(s), &m);
-            }
-        }
-        acc
-    }
-}
-
-/// How the fast path evaluates the kernel of a [`QuadFunctional`].
-#[derive(Debug, Clone)]
-enum Plan {
-    /// The kernel itself, monomorphized.
-    Own,
-    /// A run-time [`Kernel2`] that flattens to `w₁F_AO + w₂H_ω` (seed 000 (6.8)): evaluated by
-    /// the monomorphized fused kernel.
-    AoHOmega(Sum<AreaOrthogonality, HOmega>),
-    /// Any other run-time [`Kernel2`], flattened.
-    Flat(FlatKernel),
-}
-
-impl Plan {
-    fn for_kernel<K: TriKernel>(kernel: &K) -> Plan {
-        let Some(k2) = kernel.as_kernel2() else {
-            return Plan::Own;
-        };
-        let flat = k2.flattened();
-        if let [(w1, k1), (w2, k2)] = flat.as_slice() {
-            match (k1, k2) {
-                (Kernel2::AreaOrthogonality, Kernel2::HOmega(h)) => {
-                    return Plan::AoHOmega(Sum {
-                        wa: *w1,
-                        a: AreaOrthogonality,
-                        wb: *w2,
-                        b: *h,
-                    })
-                }
-                (Kernel2::HOmega(h), Kernel2::AreaOrthogonality) => {
-                    return Plan::AoHOmega(Sum {
-                        wa: *w2,
-                        a: AreaOrthogonality,
-                        wb: *w1,
-                        b: *h,
-                    })
-                }
-                _ => {}
-            }
-        }
-        Plan::Flat(FlatKernel::new(flat))
-    }
-}
-
-/// Runs `$body` with `$k` bound to the kernel the fast path uses (monomorphized per plan).
+/// Runs `$body` with `$k` bound to the kernel the fast path uses (monomorphized per plan) and
+/// `$t` to the leg pairs it needs.
 macro_rules! with_plan {
     ($self:expr, $k:ident, $t:ident => $body:expr) => {
         match &$self.plan {
-            Plan::Own => {
-                let $k = &$self.kernel;
-                let $t = $self.terms;
-                $body
-            }
             Plan::AoHOmega(kk) => {
                 let $k = kk;
                 let $t = kk.terms();
                 $body
             }
-            Plan::Flat(kk) => {
+            Plan::General(kk) => {
                 let $k = kk;
-                let $t = kk.terms;
+                let $t = $self.terms;
                 $body
             }
         }
@@ -962,25 +738,30 @@ macro_rules! with_plan {
 
 // After `with_plan!` (textual macro scope): the PSD-projected model Hessian (issue #4).
 pub mod psd;
+#[cfg(test)]
+mod reference;
 
-/// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a per-term kernel.
+/// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a [`KernelExpr`].
 ///
 /// [`Problem`] is implemented by the fast evaluator (module `lanes`: four corner lanes per cell,
-/// precomputed index and slot tables, AVX2 when available); the `*_reference` methods keep the
-/// straightforward per-triangle path, which the tests compare against.
+/// precomputed index and slot tables, AVX2 when available), running the plan chosen for the
+/// expression (module `plan`: a fused kernel for the sums it knows, a loop over the terms
+/// otherwise).
 #[derive(Debug, Clone)]
-pub struct QuadFunctional<K> {
+pub struct QuadFunctional {
     topo: Arc<QuadTopology>,
-    kernel: K,
+    kernel: KernelExpr,
     terms: Terms,
     plan: Plan,
 }
 
-impl<K: TriKernel> QuadFunctional<K> {
-    /// The functional `Σ kernel` over the leg pairs of the topology.
-    pub fn new(topo: Arc<QuadTopology>, kernel: K) -> Self {
+impl QuadFunctional {
+    /// The functional `Σ kernel` over the leg pairs of the topology (`kernel`: a
+    /// [`KernelExpr`], or anything that converts into one, e.g. a leaf kernel).
+    pub fn new(topo: Arc<QuadTopology>, kernel: impl Into<KernelExpr>) -> Self {
+        let kernel = kernel.into();
         let terms = kernel.terms();
-        let plan = Plan::for_kernel(&kernel);
+        let plan = Plan::for_expr(&kernel);
         Self {
             topo,
             kernel,
@@ -992,87 +773,17 @@ impl<K: TriKernel> QuadFunctional<K> {
     pub fn topology(&self) -> &Arc<QuadTopology> {
         &self.topo
     }
-    /// The kernel.
-    pub fn kernel(&self) -> &K {
+    /// The kernel expression.
+    pub fn kernel(&self) -> &KernelExpr {
         &self.kernel
     }
     /// Replaces the kernel (e.g. a new ω or k during a continuation), keeping the topology.
-    pub fn set_kernel(&mut self, kernel: K) {
+    pub fn set_kernel(&mut self, kernel: impl Into<KernelExpr>) {
+        let kernel = kernel.into();
         self.terms = kernel.terms();
-        self.plan = Plan::for_kernel(&kernel);
+        self.plan = Plan::for_expr(&kernel);
         self.kernel = kernel;
     }
-    /// The value with a single-threaded loop (same chunked summation as [`Problem::value`], so
-    /// the results are identical); useful as a reference.
-    pub fn value_serial(&self, x: &[f64]) -> f64 {
-        assert_eq!(
-            x.len(),
-            self.topo.num_vars(),
-            "value: x has the wrong length"
-        );
-        with_plan!(self, k, t => self.topo.asm.run_serial_chunks(|s, e| {
-            lanes::value_chunk(&self.topo, k, t, x, s, e)
-        }))
-    }
-
-    /// Reference value: the per-triangle path with the kernel as given (no lanes, no
-    /// flattening). Equal to [`Problem::value`] up to rounding.
-    pub fn value_reference(&self, x: &[f64]) -> f64 {
-        assert_eq!(
-            x.len(),
-            self.topo.num_vars(),
-            "value: x has the wrong length"
-        );
-        self.topo.asm.run_value(|c| {
-            let (p, _) = self.topo.cell_points(x, c);
-            cell_value(&self.kernel, self.terms, &p, c)
-        })
-    }
-
-    /// Reference value and gradient (per-triangle path, zero then add). Equal to
-    /// [`Problem::value_grad`] up to rounding.
-    pub fn value_grad_reference(&self, x: &[f64], g: &mut [f64]) -> f64 {
-        assert_eq!(
-            x.len(),
-            self.topo.num_vars(),
-            "value_grad: x has the wrong length"
-        );
-        assert_eq!(
-            g.len(),
-            self.topo.num_vars(),
-            "value_grad: g has the wrong length"
-        );
-        crate::csr::par_zero(g);
-        let gp = SyncPtr::new(g);
-        self.topo.asm.run_colored(|c| {
-            let (p, vars) = self.topo.cell_points(x, c);
-            let mut lg = [DVec2::ZERO; 4];
-            let v = cell_grad(&self.kernel, self.terms, &p, c, &mut lg);
-            for i in 0..4 {
-                let j = vars[i];
-                if j != FIXED {
-                    let j = 2 * j as usize;
-                    // SAFETY: node of this cell; see `assembly` (colouring).
-                    unsafe {
-                        gp.add(j, lg[i].x);
-                        gp.add(j + 1, lg[i].y);
-                    }
-                }
-            }
-            v
-        })
-    }
-
-    /// Reference Hessian refresh (per-triangle 8×8 cell matrices, zero then add, neighbour
-    /// positions found by binary search). Equal to [`Problem::hessian`] up to rounding.
-    ///
-    /// # Panics
-    /// As [`Problem::hessian`].
-    pub fn hessian_reference(&self, x: &[f64], h: &mut Csr) {
-        self.check_hessian_args(x, h);
-        self.hessian_generic(x, h);
-    }
-
     fn check_hessian_args(&self, x: &[f64], h: &Csr) {
         assert_eq!(
             x.len(),
@@ -1090,57 +801,23 @@ impl<K: TriKernel> QuadFunctional<K> {
         );
     }
 
+    /// The per-triangle Hessian assembly with the plan's kernel (the fallback of
+    /// [`Problem::hessian`] when the slot tables cannot be built).
     fn hessian_generic(&self, x: &[f64], h: &mut Csr) {
+        with_plan!(self, k, t => self.hessian_per_triangle(k, t, x, h))
+    }
+
+    fn hessian_per_triangle<KK: TriKernel>(&self, k: &KK, t: Terms, x: &[f64], h: &mut Csr) {
         self.topo.assemble_cell_hessians(x, h, false, |c, p| {
             let mut lg = [DVec2::ZERO; 4];
             let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, p, c, &mut lg, &mut lh);
+            cell_hess(k, t, p, c, &mut lg, &mut lh);
             (lh, 0.0)
-        });
-    }
-
-    /// Reference matrix-free Hessian-vector product (per-triangle 8×8 cell matrices). Equal to
-    /// [`Problem::hess_vec`] up to rounding.
-    pub fn hess_vec_reference(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
-        let n = self.topo.num_vars();
-        assert_eq!(x.len(), n, "hess_vec: x has the wrong length");
-        assert_eq!(v.len(), n, "hess_vec: v has the wrong length");
-        assert_eq!(out.len(), n, "hess_vec: out has the wrong length");
-        out.par_iter_mut().with_min_len(4096).for_each(|o| *o = 0.0);
-        let op = SyncPtr::new(out);
-        self.topo.asm.run_colored(|c| {
-            let (p, vars) = self.topo.cell_points(x, c);
-            let mut lg = [DVec2::ZERO; 4];
-            let mut lh = [[0.0; 8]; 8];
-            cell_hess(&self.kernel, self.terms, &p, c, &mut lg, &mut lh);
-            let mut lv = [0.0; 8];
-            for i in 0..4 {
-                if vars[i] != FIXED {
-                    let j = 2 * vars[i] as usize;
-                    lv[2 * i] = v[j];
-                    lv[2 * i + 1] = v[j + 1];
-                }
-            }
-            for i in 0..4 {
-                if vars[i] == FIXED {
-                    continue;
-                }
-                let j = 2 * vars[i] as usize;
-                for dx in 0..2 {
-                    let mut acc = 0.0;
-                    for (col, &vv) in lv.iter().enumerate() {
-                        acc += lh[2 * i + dx][col] * vv;
-                    }
-                    // SAFETY: node of this cell; see `assembly` (colouring).
-                    unsafe { op.add(j + dx, acc) };
-                }
-            }
-            0.0
         });
     }
 }
 
-impl<K: TriKernel> Problem for QuadFunctional<K> {
+impl Problem for QuadFunctional {
     fn dim(&self) -> usize {
         2
     }
@@ -1250,7 +927,7 @@ impl<K: TriKernel> Problem for QuadFunctional<K> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels2::DIAGONAL;
+    use crate::kernel::DIAGONAL;
 
     #[test]
     fn diagonal_pair_gives_twice_the_cell_area() {

@@ -11,7 +11,7 @@ use unamalla_functionals::*;
 use unamalla_mesh::{HasNodes, QuadMesh};
 
 /// Every 2D functional, with parameters adapted to the grid so that all are finite at `x`.
-fn all_kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
+fn all_kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, KernelExpr)> {
     let s = topo.alpha_summary(x);
     let abar = topo.alpha_bar();
     let amin = s.min;
@@ -27,24 +27,24 @@ fn all_kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
         .map(|c| 0.5 + 0.1 * (c % 7) as f64)
         .collect();
     let dens = topo.boundary_density(3.0, 1);
-    let mut v: Vec<(&'static str, Kernel2)> = vec![
-        ("length", Kernel2::Length),
+    let mut v: Vec<(&'static str, KernelExpr)> = vec![
+        ("length", KernelExpr::from(Length)),
         (
             "weighted-length",
-            Kernel2::WeightedLength(WeightedLength::new(0.3).unwrap()),
+            KernelExpr::from(WeightedLength::new(0.3).unwrap()),
         ),
-        ("area", Kernel2::Area),
-        ("castillo", Kernel2::CastilloArea),
-        ("a4p", Kernel2::A4P(A4P::new(abar).unwrap())),
-        ("orthogonality", Kernel2::Orthogonality),
-        ("area-orthogonality", Kernel2::AreaOrthogonality),
+        ("area", KernelExpr::from(Area)),
+        ("castillo", KernelExpr::from(CastilloArea)),
+        ("a4p", KernelExpr::from(A4P::new(abar).unwrap())),
+        ("orthogonality", KernelExpr::from(Orthogonality)),
+        ("area-orthogonality", KernelExpr::from(AreaOrthogonality)),
         (
             "regularized-smoothness",
-            Kernel2::RegularizedSmoothness(RegularizedSmoothness::new(eps_c).unwrap()),
+            KernelExpr::from(RegularizedSmoothness::new(eps_c).unwrap()),
         ),
         (
             "regularized-smoothness-spacing",
-            Kernel2::RegularizedSmoothness(
+            KernelExpr::from(
                 RegularizedSmoothness::new(eps_c)
                     .unwrap()
                     .spacing(SpacingWeights::from_ratios(rho.clone()).unwrap()),
@@ -52,69 +52,78 @@ fn all_kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
         ),
         (
             "regularized-inverse-area",
-            Kernel2::RegularizedInverseArea(RegularizedInverseArea::new(eps_c).unwrap()),
+            KernelExpr::from(RegularizedInverseArea::new(eps_c).unwrap()),
         ),
         (
             "generic-area",
-            Kernel2::Custom(Arc::new(GenericArea::new(move |a: f64| {
+            KernelExpr::custom(GenericArea::new(move |a: f64| {
                 let t = a / abar;
                 [
                     t.exp() + t * t * t,
                     t.exp() / abar + 3.0 * t * t / abar,
                     t.exp() / (abar * abar) + 6.0 * t / (abar * abar),
                 ]
-            }))),
-        ),
-        (
-            "k-smoothness",
-            Kernel2::KSmoothness(KSmoothness::new(k, None).unwrap()),
-        ),
-        (
-            "k-smoothness-reg",
-            Kernel2::KSmoothness(KSmoothness::new(k, Some(ah)).unwrap()),
-        ),
-        ("k-area", Kernel2::KArea(KArea::new(k, None).unwrap())),
-        (
-            "k-area-reg",
-            Kernel2::KArea(KArea::new(k, Some(ah)).unwrap()),
-        ),
-        (
-            "s-omega-eps",
-            Kernel2::SOmegaEps(SOmegaEps::new(5.0, 0.05, abar, SArgument::ScaleInvariant).unwrap()),
-        ),
-        (
-            "s-omega-eps-literal",
-            Kernel2::SOmegaEps(SOmegaEps::new(3.0 / abar, 0.05, abar, SArgument::Literal).unwrap()),
-        ),
-        ("h-omega", Kernel2::HOmega(HOmega::new(0.7 * abar).unwrap())),
-        (
-            "ao-h-omega-generic",
-            Kernel2::Custom(Arc::new(
-                Sum::convex(0.9, AreaOrthogonality, HOmega::new(0.5 * abar).unwrap()).unwrap(),
-            )),
-        ),
-        (
-            "weighted-ao-h-omega (6.9)",
-            Kernel2::Custom(Arc::new(Sum {
-                wa: 0.9,
-                a: CellWeighted::new(dens.clone(), AreaOrthogonality).unwrap(),
-                wb: 0.1,
-                b: HOmega::new(0.5 * abar).unwrap(),
             })),
         ),
         (
+            "k-smoothness",
+            KernelExpr::from(KSmoothness::new(k, None).unwrap()),
+        ),
+        (
+            "k-smoothness-reg",
+            KernelExpr::from(KSmoothness::new(k, Some(ah)).unwrap()),
+        ),
+        ("k-area", KernelExpr::from(KArea::new(k, None).unwrap())),
+        (
+            "k-area-reg",
+            KernelExpr::from(KArea::new(k, Some(ah)).unwrap()),
+        ),
+        (
+            "s-omega-eps",
+            KernelExpr::from(SOmegaEps::new(5.0, 0.05, abar, SArgument::ScaleInvariant).unwrap()),
+        ),
+        (
+            "s-omega-eps-literal",
+            KernelExpr::from(SOmegaEps::new(3.0 / abar, 0.05, abar, SArgument::Literal).unwrap()),
+        ),
+        (
+            "h-omega",
+            KernelExpr::from(HOmega::new(0.7 * abar).unwrap()),
+        ),
+        (
+            "ao-h-omega (fused)",
+            KernelExpr::convex(
+                0.9,
+                AreaOrthogonality.into(),
+                HOmega::new(0.5 * abar).unwrap().into(),
+            )
+            .unwrap(),
+        ),
+        (
+            "weighted-ao-h-omega (6.9)",
+            KernelExpr::weighted_sum([
+                (
+                    0.9,
+                    KernelExpr::from(AreaOrthogonality)
+                        .cell_weighted(dens.clone())
+                        .unwrap(),
+                ),
+                (0.1, HOmega::new(0.5 * abar).unwrap().into()),
+            ]),
+        ),
+        (
             "castillo+length+k-area normalized",
-            Kernel2::Combination(vec![
-                (0.5, Kernel2::CastilloArea),
-                (0.3, Kernel2::Length),
-                (0.2, Kernel2::KArea(KArea::new(k, None).unwrap())),
+            KernelExpr::weighted_sum(vec![
+                (0.5, KernelExpr::from(CastilloArea)),
+                (0.3, KernelExpr::from(Length)),
+                (0.2, KernelExpr::from(KArea::new(k, None).unwrap())),
             ])
             .normalized(topo.num_triangles(), abar)
             .unwrap(),
         ),
         (
             "cell-weighted area",
-            Kernel2::Area.cell_weighted(dens).unwrap(),
+            KernelExpr::from(Area).cell_weighted(dens).unwrap(),
         ),
     ];
     // Ivanenko's ((ε − α)₊)²: ε placed at least 0.05ᾱ away from every α of the grid, so the
@@ -126,14 +135,14 @@ fn all_kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
     }) {
         v.push((
             "ivanenko",
-            Kernel2::IvanenkoConvex(IvanenkoConvex::new(eps).unwrap()),
+            KernelExpr::from(IvanenkoConvex::new(eps).unwrap()),
         ));
     }
     if min_abs > 0.05 * abar {
-        v.push(("smoothness", Kernel2::Smoothness(Smoothness::new())));
+        v.push(("smoothness", KernelExpr::from(Smoothness::new())));
         v.push((
             "smoothness-spacing",
-            Kernel2::Smoothness(Smoothness::with_spacing(
+            KernelExpr::from(Smoothness::with_spacing(
                 SpacingWeights::from_ratios(rho).unwrap(),
             )),
         ));

@@ -13,7 +13,7 @@ mod common;
 
 use std::sync::Arc;
 
-use unamalla_functionals::{IvanenkoConvex, Kernel2, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::{IvanenkoConvex, KernelExpr, Problem, QuadFunctional, QuadTopology};
 use unamalla_mesh::{DVec2, StructuredGrid2};
 
 fn grid(t: f64) -> StructuredGrid2 {
@@ -27,13 +27,10 @@ fn grid(t: f64) -> StructuredGrid2 {
     .unwrap()
 }
 
-fn functional(t: f64, eps: f64) -> (QuadFunctional<Kernel2>, Vec<f64>) {
+fn functional(t: f64, eps: f64) -> (QuadFunctional, Vec<f64>) {
     let topo = Arc::new(QuadTopology::from_mesh(&grid(t)).unwrap());
     let x = topo.initial_x();
-    let f = QuadFunctional::new(
-        topo,
-        Kernel2::IvanenkoConvex(IvanenkoConvex::new(eps).unwrap()),
-    );
+    let f = QuadFunctional::new(topo, KernelExpr::from(IvanenkoConvex::new(eps).unwrap()));
     (f, x)
 }
 
@@ -97,7 +94,7 @@ fn bad_parameters_are_typed_errors() {
     assert!(IvanenkoConvex::relative(0.01, -1.0).is_err());
     assert!((IvanenkoConvex::relative(0.01, 2.0).unwrap().eps() - 0.02).abs() < 1e-15);
     // no ideal value (0 on the ideal grid): normalization is refused, not silently divided by 0
-    let k = Kernel2::IvanenkoConvex(IvanenkoConvex::new(0.5).unwrap());
+    let k = KernelExpr::from(IvanenkoConvex::new(0.5).unwrap());
     assert!(k.normalized(16, 1.0).is_err());
 }
 
@@ -123,10 +120,7 @@ fn derivatives_match_finite_differences_off_the_kink() {
             .expect("a gap in the α values");
         let below = a.iter().filter(|&&v| v < eps).count();
         assert!(below > 0 && below < a.len(), "both branches exercised");
-        let f = QuadFunctional::new(
-            topo,
-            Kernel2::IvanenkoConvex(IvanenkoConvex::new(eps).unwrap()),
-        );
+        let f = QuadFunctional::new(topo, KernelExpr::from(IvanenkoConvex::new(eps).unwrap()));
         common::check_problem("ivanenko", &f, &x, 2e-5).unwrap();
     }
 }

@@ -12,16 +12,18 @@ use unamalla_functionals::quad::psd::PsdProjection;
 use unamalla_functionals::*;
 
 /// The (6.8) kernel `(1−σ)F_AO + σH_ω`, normalized as in the driver (σ = 0.1, ω = 0.01ᾱ).
-fn ao_homega(topo: &Arc<QuadTopology>) -> QuadFunctional<Kernel2> {
+fn ao_homega(topo: &Arc<QuadTopology>) -> QuadFunctional {
     let n = topo.num_triangles();
     let ab = topo.alpha_bar();
-    let ao = Kernel2::AreaOrthogonality.normalized(n, ab).unwrap();
-    let h = Kernel2::HOmega(HOmega::new(0.01 * ab).unwrap())
+    let ao = KernelExpr::from(AreaOrthogonality)
+        .normalized(n, ab)
+        .unwrap();
+    let h = KernelExpr::from(HOmega::new(0.01 * ab).unwrap())
         .normalized(n, ab)
         .unwrap();
     QuadFunctional::new(
         topo.clone(),
-        Kernel2::Combination(vec![(0.9, ao), (0.1, h)]),
+        KernelExpr::weighted_sum(vec![(0.9, ao), (0.1, h)]),
     )
 }
 
@@ -137,7 +139,7 @@ proptest! {
         w in 0.1f64..10.0,
     ) {
         let topo = grid_topo(5, 6, amp, &noise);
-        let f = QuadFunctional::new(topo.clone(), Kernel2::Length.scaled(w));
+        let f = QuadFunctional::new(topo.clone(), KernelExpr::from(Length).scaled(w));
         let x = topo.initial_x();
         let (mut he, mut hm) = (f.hessian_pattern(), f.hessian_pattern());
         f.hessian(&x, &mut he);

@@ -7,7 +7,9 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use unamalla_functionals::{HOmega, Kernel2, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::{
+    AreaOrthogonality, HOmega, KernelExpr, Problem, QuadFunctional, QuadTopology,
+};
 use unamalla_optim::fixtures::sinusoidal;
 use unamalla_optim::linalg::{dot, norm, PrecondApply};
 use unamalla_optim::multigrid::{Multigrid, MultigridOptions};
@@ -59,13 +61,15 @@ fn main() {
     let nt = topo.num_triangles();
     let s = topo.alpha_summary(&x);
     let ab = s.mean;
-    let ao = Kernel2::AreaOrthogonality.normalized(nt, ab).expect("ao");
-    let h = Kernel2::HOmega(HOmega::new(0.01 * ab).expect("omega"))
+    let ao = KernelExpr::from(AreaOrthogonality)
+        .normalized(nt, ab)
+        .expect("ao");
+    let h = KernelExpr::from(HOmega::new(0.01 * ab).expect("omega"))
         .normalized(nt, ab)
         .expect("h");
     let p = QuadFunctional::new(
         topo.clone(),
-        Kernel2::Combination(vec![(0.9, ao), (0.1, h)]),
+        KernelExpr::weighted_sum(vec![(0.9, ao), (0.1, h)]),
     );
     let mut hm = p.hessian_pattern();
     let t = Instant::now();

@@ -12,7 +12,7 @@
 
 use std::sync::Arc;
 
-use unamalla_functionals::{Kernel2, QuadFunctional, QuadTopology};
+use unamalla_functionals::{Length, QuadFunctional, QuadTopology};
 use unamalla_mesh::StructuredGrid2;
 use unamalla_optim::drivers::{
     adaptive_k, classic_combination, ivanenko_untangle, omega_continuation, AdaptiveKOptions,
@@ -44,7 +44,7 @@ fn main() {
         for driver in ["adaptive-k", "Algorithm A"] {
             for solver in Solver::ALL {
                 let mut x = topo.initial_x();
-                let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+                let probe = QuadFunctional::new(topo.clone(), Length);
                 let mut obs = NullObserver;
                 let mut s = Session::new(&probe, &x, &mut obs);
                 let so = SolverOptions::new(solver);
@@ -151,7 +151,7 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
         let topo = Arc::new(QuadTopology::from_mesh(grid).expect("topology"));
         for o in &opts {
             let mut x = topo.initial_x();
-            let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+            let probe = QuadFunctional::new(topo.clone(), Length);
             let mut obs = NullObserver;
             let mut s = Session::new(&probe, &x, &mut obs);
             let (label, rep) = match o {

@@ -243,7 +243,7 @@ mod tests {
     use unamalla_mesh::{DVec2, StructuredGrid2};
 
     /// 3 × 3 nodes of the unit square, the middle node free at `(a, b)`.
-    fn one_free_node() -> (QuadFunctional<Length>, Vec<f64>) {
+    fn one_free_node() -> (QuadFunctional, Vec<f64>) {
         let g = StructuredGrid2::from_fn(3, 3, |i, j| DVec2::new(i as f64 * 0.5, j as f64 * 0.5))
             .unwrap();
         let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());

@@ -23,8 +23,9 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use unamalla_functionals::{
-    recommended_alpha_hat, HOmega, HexFunctional, HexTopology, IvanenkoConvex, KArea, KSmoothness,
-    Kernel2, Problem, QuadFunctional, QuadTopology, Scaling3,
+    recommended_alpha_hat, Area, AreaOrthogonality, HOmega, HexFunctional, HexTopology,
+    IvanenkoConvex, KArea, KSmoothness, KernelExpr, Length, Orthogonality, Problem, QuadFunctional,
+    QuadTopology, Scaling3,
 };
 use unamalla_mesh::{FreeNodes, HasHexCells, HasQuadCells};
 
@@ -375,11 +376,11 @@ fn quad_start(
     topo: &Arc<QuadTopology>,
     x: &[f64],
     session: &mut Session<'_>,
-) -> Result<(QuadFunctional<Kernel2>, crate::monitor::Convexity), OptimError> {
+) -> Result<(QuadFunctional, crate::monitor::Convexity), OptimError> {
     if topo.num_vars() == 0 {
         return Err(OptimError::NoFreeNodes);
     }
-    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let probe = QuadFunctional::new(topo.clone(), KernelExpr::from(Length));
     let c0 = session.convexity(&probe, x);
     let ab = c0.mean;
     if !(ab > 0.0 && ab.is_finite()) {
@@ -463,25 +464,27 @@ fn kernels(
     alpha_hat: Option<f64>,
     n: usize,
     ab: f64,
-) -> Result<(Kernel2, Option<Kernel2>), OptimError> {
+) -> Result<(KernelExpr, Option<KernelExpr>), OptimError> {
     let f1 = match kf {
         KFunctional::KSmoothArea | KFunctional::KSmoothness => {
-            Kernel2::KSmoothness(KSmoothness::new(k, alpha_hat)?)
+            KernelExpr::from(KSmoothness::new(k, alpha_hat)?)
         }
-        KFunctional::KAreaLength | KFunctional::KArea => Kernel2::KArea(KArea::new(k, alpha_hat)?),
+        KFunctional::KAreaLength | KFunctional::KArea => {
+            KernelExpr::from(KArea::new(k, alpha_hat)?)
+        }
     }
     .normalized(n, ab)?;
     let f2 = match kf {
-        KFunctional::KSmoothArea => Some(Kernel2::Area.normalized(n, ab)?),
-        KFunctional::KAreaLength => Some(Kernel2::Length.normalized(n, ab)?),
+        KFunctional::KSmoothArea => Some(KernelExpr::from(Area).normalized(n, ab)?),
+        KFunctional::KAreaLength => Some(KernelExpr::from(Length).normalized(n, ab)?),
         _ => None,
     };
     Ok((f1, f2))
 }
 
-fn combine(f1: Kernel2, f2: Option<Kernel2>, w2: f64) -> Kernel2 {
+fn combine(f1: KernelExpr, f2: Option<KernelExpr>, w2: f64) -> KernelExpr {
     match f2 {
-        Some(f2) if w2 > 0.0 => Kernel2::Combination(vec![(1.0 - w2, f1), (w2, f2)]),
+        Some(f2) if w2 > 0.0 => KernelExpr::weighted_sum(vec![(1.0 - w2, f1), (w2, f2)]),
         _ => f1,
     }
 }
@@ -510,13 +513,13 @@ fn length_presmooth(
     ab: f64,
     session: &mut Session<'_>,
     guard: &QuadLocalGuard,
-) -> Result<Option<(QuadFunctional<Kernel2>, SolveResult)>, OptimError> {
+) -> Result<Option<(QuadFunctional, SolveResult)>, OptimError> {
     if iters == 0 {
         return Ok(None);
     }
     session.set_phase(Phase::Smooth);
     let n = topo.num_triangles();
-    let p = QuadFunctional::new(topo.clone(), Kernel2::Length.normalized(n, ab)?);
+    let p = QuadFunctional::new(topo.clone(), KernelExpr::from(Length).normalized(n, ab)?);
     let so = SolverOptions {
         solver: Solver::TnLs,
         max_iter: iters,
@@ -718,10 +721,10 @@ pub fn omega_continuation(
     let guard = QuadLocalGuard::new(topo.clone());
     let (probe, c0) = quad_start(topo, x, session)?;
     let ab = c0.mean;
-    let make = |w: f64| -> Result<QuadFunctional<Kernel2>, OptimError> {
+    let make = |w: f64| -> Result<QuadFunctional, OptimError> {
         Ok(QuadFunctional::new(
             topo.clone(),
-            Kernel2::HOmega(HOmega::new(w)?).normalized(n, ab)?,
+            KernelExpr::from(HOmega::new(w)?).normalized(n, ab)?,
         ))
     };
     let mut omega = opts.omega0_rel * ab;
@@ -1063,18 +1066,18 @@ pub fn block_smoothing(
         }
     }
     let c = session.convexity(&probe, x);
-    let ao = Kernel2::AreaOrthogonality.normalized(n, ab)?;
+    let ao = KernelExpr::from(AreaOrthogonality).normalized(n, ab)?;
     let ao = if opts.density != 1.0 {
         ao.cell_weighted(topo.boundary_density(opts.density, opts.layers))?
     } else {
         ao
     };
     let omega = opts.eps * ab;
-    let h = Kernel2::HOmega(HOmega::new(omega)?).normalized(n, ab)?;
+    let h = KernelExpr::from(HOmega::new(omega)?).normalized(n, ab)?;
     let functional = |sigma: f64| {
         QuadFunctional::new(
             topo.clone(),
-            Kernel2::Combination(vec![(1.0 - sigma, ao.clone()), (sigma, h.clone())]),
+            KernelExpr::weighted_sum(vec![(1.0 - sigma, ao.clone()), (sigma, h.clone())]),
         )
     };
     session.set_phase(Phase::Classic);
@@ -1090,10 +1093,7 @@ pub fn block_smoothing(
     if opts.solver.stop.plateau_alpha > 0.0 {
         session.set_quality(Some(crate::monitor::quad_mu_share(topo.clone())));
     }
-    let run = |p: &QuadFunctional<Kernel2>,
-               x: &mut [f64],
-               so: &SolverOptions,
-               session: &mut Session<'_>| {
+    let run = |p: &QuadFunctional, x: &mut [f64], so: &SolverOptions, session: &mut Session<'_>| {
         if so.hessian == HessianMode::ProjectedPsd {
             let model = PsdModel::new(p, PsdProjection::Clamp);
             minimize_with(&model, x, so, session, Some(&guard))
@@ -1152,7 +1152,7 @@ impl ClassicCombination {
         }
     }
     /// The normalized kernel `σ·F̃₁ + (1 − σ)·F̃₂` for `n` corner triangles of mean `ᾱ`.
-    pub fn kernel(self, sigma: f64, n: usize, alpha_bar: f64) -> Result<Kernel2, OptimError> {
+    pub fn kernel(self, sigma: f64, n: usize, alpha_bar: f64) -> Result<KernelExpr, OptimError> {
         check_sigma("sigma", sigma)?;
         if let Some(f) = self.fixed_sigma() {
             if sigma != f {
@@ -1164,12 +1164,12 @@ impl ClassicCombination {
             }
         }
         let f2 = match self {
-            ClassicCombination::AreaLength => Kernel2::Length,
-            ClassicCombination::AreaOrthogonality => Kernel2::Orthogonality,
+            ClassicCombination::AreaLength => KernelExpr::from(Length),
+            ClassicCombination::AreaOrthogonality => KernelExpr::from(Orthogonality),
         };
-        Ok(Kernel2::convex(
+        Ok(KernelExpr::convex(
             sigma,
-            Kernel2::Area.normalized(n, alpha_bar)?,
+            KernelExpr::from(Area).normalized(n, alpha_bar)?,
             f2.normalized(n, alpha_bar)?,
         )?)
     }
@@ -1251,7 +1251,7 @@ pub fn ivanenko_untangle(
         return Ok(report(session, &probe, x, &init, messages, None, eps));
     }
     let e = 2.0 * eps * ab;
-    let k = Kernel2::IvanenkoConvex(IvanenkoConvex::new(e)?).scaled(1.0 / (n as f64 * e * e));
+    let k = KernelExpr::from(IvanenkoConvex::new(e)?).scaled(1.0 / (n as f64 * e * e));
     session.set_phase(Phase::Homotopic);
     session.guard_threshold = 0.0;
     let p = QuadFunctional::new(topo.clone(), k);
@@ -1477,7 +1477,7 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
     }
     let mut x = topo.initial_x();
     let x0 = x.clone();
-    let probe = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let probe = QuadFunctional::new(topo.clone(), KernelExpr::from(Length));
     let mut session = Session::new(&probe, &x, observer);
     if let Some(t) = opts.time_limit {
         if !(t.is_finite() && t >= 0.0) {

@@ -4,7 +4,8 @@
 //! `unamalla-functionals` and the continuation drivers that make meshes convex and smooth.
 //! Design follows `argmin`'s separation: a [`Problem`](unamalla_functionals::Problem)
 //! (value, gradient, sparse Hessian / Hessian-vector product, local models, element
-//! measures), a solver ([`solver`]), an observer ([`monitor`]).
+//! measures), a solver ([`solver`]), an observer ([`monitor`]) and the convexity safeguard
+//! ([`safeguard`]).
 //!
 //! ## Solvers ([`solver`]; seed 001 digest §3 and App. B)
 //! * **Truncated Newton, trust region** ([`Solver::TnTr`], UNAMALLA's default; the TRON family
@@ -41,7 +42,7 @@
 //! ([`argmin_adapter`]); the timing comparison is in docs/benchmarks.md.
 //!
 //! ## Safeguard (the convexity contract)
-//! A [`Session`](monitor::Session) finds the elements with at least one free vertex (by
+//! A [`Session`] finds the elements with at least one free vertex (by
 //! perturbing the variables) and, whenever the current iterate has all of them above a
 //! threshold (0, or `ε·ᾱ` in the ε-convex phases), rejects trial points that do not (line
 //! search: bisection toward the best point; trust region: `ρ = −∞`; pointwise: the node step
@@ -53,12 +54,12 @@
 //! region with very thin passages), two details matter (issue #8, gulf-of-mexico):
 //! * the trust-region step is cut at the exact first crossing (α is quadratic along a 2D
 //!   step); if that shortens the step, the nodes of the blocking cells are **held back**
-//!   instead ([`Session::hold_back`](monitor::Session::hold_back): their direction components
+//!   instead ([`Session::hold_back`]: their direction components
 //!   are zeroed until no cell would reach the threshold within twice the step) and the
 //!   held-back step is taken when its model decrease is larger — otherwise one cell at the
 //!   threshold shortens every node's step and the whole run stalls;
 //! * an iterate that ends within the margin `10⁻⁹·ᾱ` of the threshold (or, by rounding, a hair
-//!   below it) keeps a guard at `α₋ − 10⁻⁹·ᾱ` ([`Session::guard_active`](monitor::Session::guard_active));
+//!   below it) keeps a guard at `α₋ − 10⁻⁹·ᾱ` ([`Session::guard_active`]);
 //!   before, the guard switched off there and the run could fold cells again (the pipeline
 //!   then had to fall back to the start of the run). Test: `tests/guard.rs`.
 //!
@@ -68,7 +69,7 @@
 //! calls) and trust-radius collapse; beyond Table A.2, the window tests of [`StopRules`]
 //! (relative decrease of F over `W` iterations, quality plateau of α₋/ᾱ and the μ ≥ 0.8
 //! share) and an explicit time limit
-//! ([`Session::set_time_limit`](monitor::Session::set_time_limit), "STOP by TIME LIMIT" —
+//! ([`Session::set_time_limit`], "STOP by TIME LIMIT" —
 //! never a default: without it a run's result does not depend on the machine). [`Status`]'s `Display` prints the UNAMALLA messages.
 //!
 //! ## Observer ([`monitor`]; Table A.1)
@@ -118,6 +119,7 @@ pub mod linesearch;
 pub mod monitor;
 pub mod multigrid;
 pub mod psd_model;
+pub mod safeguard;
 pub mod shape;
 pub mod solver;
 pub mod status;
@@ -131,6 +133,7 @@ pub use drivers::{
 pub use error::OptimError;
 pub use linalg::Preconditioner;
 pub use monitor::{Control, Monitor, NullObserver, Observer, Phase, ProgressObserver};
+pub use safeguard::{Convexity, Session};
 pub use shape::{improve_shape, BoundarySlide, ShapeOptions, ShapeReport};
 pub use solver::{
     minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions, StopRules,

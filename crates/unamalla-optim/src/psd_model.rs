@@ -12,27 +12,27 @@
 //! [`HessianMode::MatrixFree`], where no model is assembled).
 
 use unamalla_functionals::quad::psd::PsdProjection;
-use unamalla_functionals::{Csr, LocalModel, Problem, QuadFunctional, TriKernel};
+use unamalla_functionals::{Csr, LocalModel, Problem, QuadFunctional};
 
 #[cfg(doc)]
 use crate::solver::HessianMode;
 
 /// A borrowed quad functional with the PSD-projected model Hessian (module docs).
 #[derive(Debug, Clone, Copy)]
-pub struct PsdModel<'a, K> {
-    f: &'a QuadFunctional<K>,
+pub struct PsdModel<'a> {
+    f: &'a QuadFunctional,
     mode: PsdProjection,
 }
 
-impl<'a, K: TriKernel> PsdModel<'a, K> {
+impl<'a> PsdModel<'a> {
     /// Wraps `f`; `mode` chooses clamping (default) or absolute values of the negative
     /// eigenvalues.
-    pub fn new(f: &'a QuadFunctional<K>, mode: PsdProjection) -> Self {
+    pub fn new(f: &'a QuadFunctional, mode: PsdProjection) -> Self {
         Self { f, mode }
     }
 }
 
-impl<K: TriKernel> Problem for PsdModel<'_, K> {
+impl Problem for PsdModel<'_> {
     fn dim(&self) -> usize {
         self.f.dim()
     }
@@ -119,17 +119,19 @@ mod tests {
     #[test]
     fn model_hessian_differs_from_exact_and_is_psd_on_the_tfi_grid() {
         use std::sync::Arc;
-        use unamalla_functionals::{HOmega, Kernel2, QuadTopology};
+        use unamalla_functionals::{AreaOrthogonality, HOmega, KernelExpr, QuadTopology};
         let g = sinusoidal(9, 9, 0.1, 2.0).expect("grid");
         let topo = Arc::new(QuadTopology::from_mesh(&g).expect("topo"));
         let (n, ab) = (topo.num_triangles(), topo.alpha_bar());
-        let ao = Kernel2::AreaOrthogonality.normalized(n, ab).expect("ao");
-        let h = Kernel2::HOmega(HOmega::new(0.01 * ab).expect("omega"))
+        let ao = KernelExpr::from(AreaOrthogonality)
+            .normalized(n, ab)
+            .expect("ao");
+        let h = KernelExpr::from(HOmega::new(0.01 * ab).expect("omega"))
             .normalized(n, ab)
             .expect("h");
         let f = QuadFunctional::new(
             topo.clone(),
-            Kernel2::Combination(vec![(0.9, ao), (0.1, h)]),
+            KernelExpr::weighted_sum(vec![(0.9, ao), (0.1, h)]),
         );
         let m = PsdModel::new(&f, PsdProjection::Clamp);
         let x = topo.initial_x();

@@ -20,7 +20,7 @@ use unamalla_optim::fixtures::sinusoidal;
 use unamalla_optim::monitor::{NullObserver, Session};
 use unamalla_optim::solver::{minimize, Solver, SolverOptions};
 
-type Winslow = QuadFunctional<Smoothness>;
+type Winslow = QuadFunctional;
 
 /// Winslow's functional `Σ l/α` on the TFI grid of the sinusoidal square (convex start).
 fn winslow(n: usize) -> (Winslow, Vec<f64>) {

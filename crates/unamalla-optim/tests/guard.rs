@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use unamalla_functionals::{Csr, Kernel2, LocalModel, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::{Csr, Length, LocalModel, Problem, QuadFunctional, QuadTopology};
 use unamalla_optim::drivers::{smooth, SmoothOptions};
 use unamalla_optim::fixtures::ivanenko;
 use unamalla_optim::monitor::{HistoryObserver, NullObserver, Session};
@@ -11,7 +11,7 @@ use unamalla_optim::solver::{minimize_with, Solver, SolverOptions};
 
 /// The same problem without [`Problem::element_nodes`]: the safeguard can then only shorten
 /// the whole step (the behaviour before the held-back step existed).
-struct Anonymous<'a>(&'a QuadFunctional<Kernel2>);
+struct Anonymous<'a>(&'a QuadFunctional);
 
 impl Problem for Anonymous<'_> {
     fn dim(&self) -> usize {
@@ -77,7 +77,7 @@ fn a_cell_at_the_threshold_is_held_back_and_the_rest_of_the_mesh_converges() {
     smooth(&mut g, &SmoothOptions::default(), &mut NullObserver).unwrap();
     let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
     let x0 = topo.initial_x();
-    let p = QuadFunctional::new(topo.clone(), Kernel2::Length);
+    let p = QuadFunctional::new(topo.clone(), Length);
     let min0 = Session::new(&p, &x0, &mut NullObserver).masked_min(&p, &x0);
     assert!(min0 > 0.0);
     let thr = 0.999 * min0;

@@ -58,7 +58,7 @@ fn run_with(opts: &AdaptiveKOptions) -> (Vec<f64>, bool, usize) {
     let g = fixture();
     let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
     let mut x = topo.initial_x();
-    let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Kernel2::Length);
+    let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Length);
     let mut obs = NullObserver;
     let mut s = Session::new(&probe, &x, &mut obs);
     let r = adaptive_k(&topo, &mut x, opts, &mut s).unwrap();
@@ -242,7 +242,7 @@ fn stopping_at_the_target_bound_ends_a_homotopy_the_thesis_loop_cannot_end() {
     })
     .unwrap();
     let topo = Arc::new(QuadTopology::from_mesh(&g).unwrap());
-    let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Kernel2::Length);
+    let probe = QuadFunctional::new(topo.clone(), unamalla_functionals::Length);
     let bound = 0.5 * delta / (0.5 + delta) / 0.25;
     let run = |stop_at_target: bool| {
         let mut x = topo.initial_x();

@@ -6,12 +6,12 @@
 use std::sync::Arc;
 
 use proptest::prelude::*;
-use unamalla_functionals::{Kernel2, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::{Length, Problem, QuadFunctional, QuadTopology};
 use unamalla_optim::fixtures::sinusoidal;
 use unamalla_optim::monitor::{NullObserver, Session};
 
 /// `min α(x + t·d)` over the corner triangles that move (have a free node).
-fn min_measure(p: &QuadFunctional<Kernel2>, moving: &[bool], x: &[f64], d: &[f64], t: f64) -> f64 {
+fn min_measure(p: &QuadFunctional, moving: &[bool], x: &[f64], d: &[f64], t: f64) -> f64 {
     let xt: Vec<f64> = x.iter().zip(d).map(|(a, b)| a + t * b).collect();
     let mut m = vec![0.0; p.num_elements()];
     p.element_measures(&xt, &mut m);
@@ -25,7 +25,7 @@ fn min_measure(p: &QuadFunctional<Kernel2>, moving: &[bool], x: &[f64], d: &[f64
 /// The first crossing of `thr` on `(0, t_max]` by scanning 4000 steps and bisecting (`∞` if
 /// none).
 fn brute_force(
-    p: &QuadFunctional<Kernel2>,
+    p: &QuadFunctional,
     moving: &[bool],
     x: &[f64],
     d: &[f64],
@@ -53,11 +53,11 @@ fn brute_force(
     f64::INFINITY
 }
 
-fn setup() -> (QuadFunctional<Kernel2>, Vec<f64>, Vec<bool>) {
+fn setup() -> (QuadFunctional, Vec<f64>, Vec<bool>) {
     let g = sinusoidal(9, 9, 0.1, 1.0).expect("grid");
     let topo = Arc::new(QuadTopology::from_mesh(&g).expect("topology"));
     let x = topo.initial_x();
-    let p = QuadFunctional::new(topo, Kernel2::Length);
+    let p = QuadFunctional::new(topo, Length);
     // the triangles that move: their measure changes when the free variables move (by
     // different amounts: a translation of all three nodes would not change a triangle)
     let mut a = vec![0.0; p.num_elements()];

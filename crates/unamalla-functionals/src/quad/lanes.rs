@@ -37,7 +37,7 @@ use glam::DVec2;
 
 use super::{scalars, QuadTopology, LEGS};
 use crate::assembly::{SyncPtr, FIXED, FIXED_BIT};
-use crate::kernels2::{CornerLanes, Order, Terms, TriKernel};
+use crate::kernel::{CornerLanes, Order, Terms, TriKernel};
 
 /// Flag bit of a Hessian slot entry: this contribution is the first to reach its block.
 pub(crate) const SLOT_FIRST: u16 = 1 << 15;

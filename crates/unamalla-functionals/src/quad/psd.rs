@@ -31,7 +31,7 @@
 
 use super::{leg_hessian, pair_range, scalars, scatter_leg_hessian, Plan, QuadFunctional, LEGS};
 use crate::csr::Csr;
-use crate::kernels2::{Order, Terms, TriKernel};
+use crate::kernel::{Order, Terms, TriKernel};
 
 /// How [`QuadFunctional::hessian_psd`] projects a triangle's leg Hessian (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -148,7 +148,7 @@ pub fn project_psd4(m: &mut [[f64; 4]; 4], mode: PsdProjection) -> bool {
     true
 }
 
-impl<K: TriKernel> QuadFunctional<K> {
+impl QuadFunctional {
     /// The PSD model Hessian (module docs) at `x`, written into `h` (which must come from
     /// [`hessian_pattern`](crate::Problem::hessian_pattern)); returns the number of triangle
     /// terms whose leg Hessian was projected.
@@ -162,9 +162,9 @@ impl<K: TriKernel> QuadFunctional<K> {
 }
 
 /// The assembly of [`QuadFunctional::hessian_psd`] with the kernel `k` of the fast path's plan
-/// (for a run-time [`Kernel2`](crate::Kernel2) sum: the flattened, monomorphized kernel).
-fn psd_assemble<K: TriKernel, KK: TriKernel>(
-    f: &QuadFunctional<K>,
+/// (the fused or general kernel chosen for the expression).
+fn psd_assemble<KK: TriKernel>(
+    f: &QuadFunctional,
     kernel: &KK,
     terms: Terms,
     x: &[f64],

@@ -1,10 +1,11 @@
-//! The fast evaluator (corner lanes, precomputed slots, first-contribution stores, flattened
-//! `Kernel2`, AVX2 dispatch) agrees with the reference per-triangle path
-//! (`QuadFunctional::*_reference`) to rounding — value, gradient, Hessian and Hessian-vector
+//! The fast evaluator (corner lanes, precomputed slots, first-contribution stores, the plan
+//! chosen for the `KernelExpr`, AVX2 dispatch) agrees with the reference per-triangle path
+//! (`QuadFunctional::*_reference`, [`super`]) to rounding — value, gradient, Hessian and Hessian-vector
 //! product — on random convex and folded grids and on unstructured quad meshes, for every
-//! kind of kernel (typed, run-time, custom, per-cell weighted, diagonal pair).
+//! kind of kernel (fused, general, nested, custom, per-cell weighted, diagonal pair).
 #![allow(clippy::needless_range_loop)]
 
+#[path = "../../../tests/common/mod.rs"]
 mod common;
 
 use std::sync::Arc;
@@ -24,7 +25,7 @@ fn max_abs(v: &[f64]) -> f64 {
 }
 
 /// Compares fast and reference paths of one functional at `x`.
-fn compare<K: TriKernel>(name: &str, f: &QuadFunctional<K>, x: &[f64]) -> Result<(), String> {
+fn compare(name: &str, f: &QuadFunctional, x: &[f64]) -> Result<(), String> {
     let n = f.num_vars();
     let (mut g_fast, mut g_ref) = (vec![0.0; n], vec![0.0; n]);
     // garbage in the output buffers: the fast path must overwrite, not accumulate
@@ -88,7 +89,7 @@ fn compare<K: TriKernel>(name: &str, f: &QuadFunctional<K>, x: &[f64]) -> Result
 }
 
 /// Run-time kernels covering every leaf and combinator, with parameters that keep them finite.
-fn kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
+fn kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, KernelExpr)> {
     let s = topo.alpha_summary(x);
     let abar = topo.alpha_bar();
     let k = -s.min + 0.5 * abar;
@@ -99,36 +100,38 @@ fn kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
         .map(|c| 0.5 + 0.1 * (c % 7) as f64)
         .collect();
     let dens = topo.boundary_density(3.0, 1);
-    let ao = Kernel2::AreaOrthogonality.normalized(n, abar).unwrap();
-    let h = Kernel2::HOmega(HOmega::new(0.5 * abar).unwrap())
+    let ao = KernelExpr::from(AreaOrthogonality)
+        .normalized(n, abar)
+        .unwrap();
+    let h = KernelExpr::from(HOmega::new(0.5 * abar).unwrap())
         .normalized(n, abar)
         .unwrap();
     vec![
-        // the pipeline's nested form of seed 000 (6.8): routed to the fused typed kernel
+        // the pipeline's form of seed 000 (6.8): routed to the fused kernel
         (
             "nested normalized ao + h-omega",
-            Kernel2::Combination(vec![(0.9, ao), (0.1, h)]),
+            KernelExpr::weighted_sum(vec![(0.9, ao), (0.1, h)]),
         ),
         (
             "h-omega + ao (reversed)",
-            Kernel2::convex(
+            KernelExpr::convex(
                 0.2,
-                Kernel2::HOmega(HOmega::new(0.7 * abar).unwrap()),
-                Kernel2::AreaOrthogonality,
+                KernelExpr::from(HOmega::new(0.7 * abar).unwrap()),
+                KernelExpr::from(AreaOrthogonality),
             )
             .unwrap(),
         ),
-        ("length", Kernel2::Length),
+        ("length", KernelExpr::from(Length)),
         (
             "weighted-length",
-            Kernel2::WeightedLength(WeightedLength::new(0.3).unwrap()),
+            KernelExpr::from(WeightedLength::new(0.3).unwrap()),
         ),
-        ("area", Kernel2::Area),
-        ("a4p", Kernel2::A4P(A4P::new(abar).unwrap())),
-        ("orthogonality", Kernel2::Orthogonality),
+        ("area", KernelExpr::from(Area)),
+        ("a4p", KernelExpr::from(A4P::new(abar).unwrap())),
+        ("orthogonality", KernelExpr::from(Orthogonality)),
         (
             "regularized-smoothness-spacing",
-            Kernel2::RegularizedSmoothness(
+            KernelExpr::from(
                 RegularizedSmoothness::new(eps_c)
                     .unwrap()
                     .spacing(SpacingWeights::from_ratios(rho).unwrap()),
@@ -136,35 +139,35 @@ fn kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
         ),
         (
             "regularized-inverse-area",
-            Kernel2::RegularizedInverseArea(RegularizedInverseArea::new(eps_c).unwrap()),
+            KernelExpr::from(RegularizedInverseArea::new(eps_c).unwrap()),
         ),
         (
             "k-smoothness-reg",
-            Kernel2::KSmoothness(KSmoothness::new(k, Some(ah)).unwrap()),
+            KernelExpr::from(KSmoothness::new(k, Some(ah)).unwrap()),
         ),
-        ("k-area", Kernel2::KArea(KArea::new(k, None).unwrap())),
+        ("k-area", KernelExpr::from(KArea::new(k, None).unwrap())),
         (
             "s-omega-eps",
-            Kernel2::SOmegaEps(SOmegaEps::new(5.0, 0.05, abar, SArgument::ScaleInvariant).unwrap()),
+            KernelExpr::from(SOmegaEps::new(5.0, 0.05, abar, SArgument::ScaleInvariant).unwrap()),
         ),
         (
             "custom generic-area",
-            Kernel2::Custom(Arc::new(GenericArea::new(move |a: f64| {
+            KernelExpr::custom(GenericArea::new(move |a: f64| {
                 let t = a / abar;
                 [t * t * t, 3.0 * t * t / abar, 6.0 * t / (abar * abar)]
-            }))),
+            })),
         ),
         (
             "castillo + length + k-area",
-            Kernel2::Combination(vec![
-                (0.5, Kernel2::CastilloArea),
-                (0.3, Kernel2::Length),
-                (0.2, Kernel2::KArea(KArea::new(k, None).unwrap())),
+            KernelExpr::weighted_sum(vec![
+                (0.5, KernelExpr::from(CastilloArea)),
+                (0.3, KernelExpr::from(Length)),
+                (0.2, KernelExpr::from(KArea::new(k, None).unwrap())),
             ]),
         ),
         (
             "cell-weighted area",
-            Kernel2::Area.cell_weighted(dens).unwrap(),
+            KernelExpr::from(Area).cell_weighted(dens).unwrap(),
         ),
     ]
 }
@@ -172,28 +175,39 @@ fn kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, Kernel2)> {
 fn check_all(topo: &Arc<QuadTopology>) -> Result<(), String> {
     let x = topo.initial_x();
     let abar = topo.alpha_bar();
-    // typed kernels (monomorphized lanes)
-    let typed = QuadFunctional::new(
+    // the fused plan (w₁F_AO + w₂H_ω) and nested groupings
+    let fused = QuadFunctional::new(
         topo.clone(),
-        Sum::convex(0.9, AreaOrthogonality, HOmega::new(0.5 * abar).unwrap()).unwrap(),
+        KernelExpr::convex(
+            0.9,
+            AreaOrthogonality.into(),
+            HOmega::new(0.5 * abar).unwrap().into(),
+        )
+        .unwrap(),
     );
-    compare("typed ao + h-omega", &typed, &x)?;
+    compare("fused ao + h-omega", &fused, &x)?;
     let weighted = QuadFunctional::new(
         topo.clone(),
-        Sum {
-            wa: 0.9,
-            a: CellWeighted::new(topo.boundary_density(3.0, 1), AreaOrthogonality).unwrap(),
-            wb: 0.1,
-            b: Scaled {
-                factor: 2.0,
-                inner: HOmega::new(0.5 * abar).unwrap(),
-            },
-        },
+        KernelExpr::nested_sum([
+            (
+                0.9,
+                KernelExpr::from(AreaOrthogonality)
+                    .cell_weighted(topo.boundary_density(3.0, 1))
+                    .unwrap(),
+            ),
+            (
+                0.1,
+                KernelExpr::nested_sum([(2.0, HOmega::new(0.5 * abar).unwrap().into())]),
+            ),
+        ]),
     );
-    compare("typed weighted (6.9)", &weighted, &x)?;
+    compare("nested weighted (6.9)", &weighted, &x)?;
     compare(
-        "typed castillo + area",
-        &QuadFunctional::new(topo.clone(), Sum::convex(0.5, CastilloArea, Area).unwrap()),
+        "castillo + area",
+        &QuadFunctional::new(
+            topo.clone(),
+            KernelExpr::convex(0.5, CastilloArea.into(), Area.into()).unwrap(),
+        ),
         &x,
     )?;
     for (name, k) in kernels(topo, &x) {
@@ -287,10 +301,10 @@ fn fast_path_is_bit_identical_across_thread_counts_on_a_multi_chunk_grid() {
     let abar = topo.alpha_bar();
     let f = QuadFunctional::new(
         topo.clone(),
-        Kernel2::convex(
+        KernelExpr::convex(
             0.9,
-            Kernel2::AreaOrthogonality,
-            Kernel2::HOmega(HOmega::new(0.5 * abar).unwrap()),
+            KernelExpr::from(AreaOrthogonality),
+            KernelExpr::from(HOmega::new(0.5 * abar).unwrap()),
         )
         .unwrap(),
     );
@@ -311,6 +325,8 @@ fn fast_path_is_bit_identical_across_thread_counts_on_a_multi_chunk_grid() {
         })
     };
     let one = run(1);
+    // the single-threaded loop with the same chunked summation gives the same value
+    assert_eq!(one.0, f.value_serial(&x).to_bits());
     assert!(one == run(2));
     assert!(one == run(3));
     // and the fast path agrees with the reference here too
