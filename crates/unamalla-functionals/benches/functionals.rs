@@ -1,7 +1,7 @@
-//! Criterion benchmarks: value + gradient and Hessian refresh of
-//! `0.9·F_AO + 0.1·H_ω` (seed 000 (6.8), σ = 0.1) on quad grids and of `H_ω` (10 tets per hex)
-//! on hex grids. Throughput is reported in triangles (2D, 4 per cell) or tetrahedra (3D, 10 per
-//! cell) per second. Run once with `RAYON_NUM_THREADS=1` (one core) and once without.
+//! Criterion benchmarks: value + gradient and Hessian refresh of `0.9·F_AO + 0.1·H_ω`
+//! ([Méndez 2023, (6.8)], σ = 0.1) on quad grids and of `H_ω` (10 tets per hex) on hex grids.
+//! Throughput is reported in triangles (2D, 4 per cell) or tetrahedra (3D, 10 per cell) per second.
+//! Run once with `RAYON_NUM_THREADS=1` (one core) and once without.
 //!
 //! Sizes can be restricted with the environment variable `UNAMALLA_BENCH_SIZES`, e.g.
 //! `UNAMALLA_BENCH_SIZES=q100,q300,q1000,h20,h50,h100` (the default is all of them).

@@ -1,4 +1,4 @@
-//! Timing of `0.9·F_AO + 0.1·H_ω` (seed 000 (6.8), σ = 0.1, ω = ᾱ/2) on an `n × n`-cell grid:
+//! Timing of `0.9·F_AO + 0.1·H_ω` ([Méndez 2023, (6.8)], σ = 0.1, ω = ᾱ/2) on an `n × n`-cell grid:
 //! value + gradient, Hessian refresh, matrix-free Hessian-vector product and CSR SpMV, with the
 //! evaluator's fused plan (`KernelExpr::convex(0.9, F_AO, H_ω)`) and, for comparison, the general
 //! plan (the same sum wrapped in a one-part `nested_sum`, which the evaluator does not fuse).

@@ -1,19 +1,23 @@
-//! 3D functionals on hex meshes (seed 004 digest §3–§4): the quasi-harmonic `H_ω` over 10
-//! tetrahedra per hexahedron and the face-coplanarity penalty `C·Σk²`.
+//! 3D functionals on hex meshes ([Cortés Aguirre 2012, Ch. 3–4]; the references are listed in
+//! `docs/references.md` of the repository): the quasi-harmonic `H_ω` over 10 tetrahedra per
+//! hexahedron and the face-coplanarity penalty `C·Σk²`.
 //!
-//! # Tetrahedra (seed 004 digest §3.2, the list reconstructed there \[I\])
+//! # Tetrahedra ([Cortés Aguirre 2012, §3.2], the list completed here)
 //! Vertices are numbered 1..8 as in the thesis (VTK order, 0-based in code). Decomposition A:
 //! corner tets 1245, 3427, 6572, 8547 and interior tet 7425; decomposition B: 2316, 4138, 5861,
 //! 7683 and interior tet 1386. A corner tet `PQRS` has Jacobian columns `Q−P, R−P, S−P`; the
 //! interior tets use the volume-averaged stencils
 //! `r_ξ = ½(r₇+r₂−r₅−r₄)`, `r_η = ½(r₇+r₄−r₅−r₂)`, `r_ζ = ½(r₇+r₅−r₂−r₄)` (7425) and
-//! `r_ξ = ½(r₃+r₆−r₁−r₈)`, `r_η = ½(r₃+r₈−r₁−r₆)`, `r_ζ = ½(r₆+r₈−r₁−r₃)` (1386, \[I\]).
+//! `r_ξ = ½(r₃+r₆−r₁−r₈)`, `r_η = ½(r₃+r₈−r₁−r₆)`, `r_ζ = ½(r₆+r₈−r₁−r₃)` (1386). The thesis
+//! names the tets 1245, 6572, 8547, 5861 and the interior tet 7425 and gives the stencil of 7425;
+//! the rest of the list and the stencil of 1386 are ours (exact for affine maps).
 //! All ten have `V = det[r_ξ, r_η, r_ζ] > 0` on the unit cube (tested). For interior tets
-//! `V = 3·vol` (not 6·vol, digest erratum 5).
+//! `V = 3·vol` (not the 6·vol the thesis states for every tet).
 //!
-//! # Scaling switch (\[I\], digest §3.2 "Scaling")
-//! The printed formulas use raw (index-space) differences; the thesis' reported values fit
-//! unit-parametric Jacobians `r_ξ ≈ (m−1)(r₂−r₁)`. [`Scaling3::Index`] uses raw differences,
+//! # Scaling switch (our reading)
+//! The printed formulas use raw (index-space) differences; the thesis' reported values fit only
+//! unit-parametric Jacobians `r_ξ ≈ (m−1)(r₂−r₁)` (with raw differences its Pico example, which
+//! ends at `f = 2.79`, would give about 0.05). [`Scaling3::Index`] uses raw differences,
 //! [`Scaling3::Parametric`] multiplies each column by the number of cells along its logical
 //! direction.
 //!
@@ -21,11 +25,11 @@
 //! Per tet `λ = (‖r_ξ‖² + ‖r_η‖² + ‖r_ζ‖²)^{3/2}/3^{3/2}` (control metric `G = I`) and the term
 //! `λ·φ_ω(V)` with the C¹ [`phi_omega`]; `H_ω = 1/(10N_c) ΣΣ λφ_ω(V)` (3.27). Where `V ≥ ω`
 //! the term is the energy density `E = λ/V ≥ 1` (AM–GM), with equality iff the Jacobian is a
-//! similarity. Derivatives (vector form of the digest): `∂λ/∂c = r c` with `r = (s/3)^{1/2}`,
+//! similarity. Derivatives (in vector form, ours): `∂λ/∂c = r c` with `r = (s/3)^{1/2}`,
 //! `s = Σ‖c‖²`, `∂²λ = rI + ccᵀ/(3r)`; `∂V/∂c₁ = c₂×c₃` (cyclic), `∂²V/∂c_a∂c_b = ε_{abc}M(c_c)`
 //! with `M(w)_{ij} = ε_{ijk}w_k`; chained to the vertices through the stencils.
 //!
-//! # Node-block Hessian (issue #10)
+//! # Node-block Hessian
 //! With the stencil column `w_j = (w_0j, w_1j, w_2j)` of vertex `j`, `α_j = Σ_a w_aj c_a`,
 //! `β_j = Σ_a w_aj ∂V/∂c_a` and `G_jl = w_j·w_l`, the chain rule
 //! `H_jl = Σ_ab w_aj w_bl ∂²f/∂c_a∂c_b` collapses (using `Σ_ab w_aj w_bl ε_abc = (w_j × w_l)_c`) to
@@ -36,14 +40,14 @@
 //! with the pattern ([`HexTopology::block_slots`]). The face terms use the same form (legs
 //! `B−A, D−A, C−A`). The previous assembly is kept as [`HexFunctional::hessian_reference`].
 //!
-//! # Coplanarity (seed 004 §4.1 criterion 2, (4.2)–(4.4))
+//! # Coplanarity ([Cortés Aguirre 2012, §4.1] criterion 2, (4.2)–(4.4))
 //! For a face `ABCD`: `N = AB × AD`, `k = N·AC/(‖N‖‖AC‖)` (a signed cosine; `k² = |cos|²`). The
 //! penalty is `C·Σ_cells Σ_faces k²` over the six faces (1234), (5678), (1265), (4378), (1485),
 //! (2376) of the **interior cells** (default: cells with all eight nodes free; shared faces are
 //! counted twice, as in the thesis). `A` is the first listed vertex of each face; the thesis'
 //! "six combinations of the four vertices" is ambiguous, so the smooth single-cosine form is
 //! used in the penalty, and [`face_planarity_max_cos`] (max `|cos|` over the four leave-one-out
-//! choices of `A`, the digest's \[I\] reading) is offered as the reporting measure. Derivatives of
+//! choices of `A`, our reading) is offered as the reporting measure. Derivatives of
 //! `k² = t²/(n₂w₂)` with `t = det[AB, AD, AC]`, `n₂ = ‖AB × AD‖²`, `w₂ = ‖AC‖²` are exact
 //! (polynomial parts differentiated by hand). A face with `n₂w₂ = 0` contributes 0.
 
@@ -59,7 +63,7 @@ use crate::error::FunctionalError;
 use crate::kernel::phi_omega;
 use crate::problem::{LocalModel, Problem};
 
-/// The six faces of a hexahedron (0-based VTK indices) in the seed 004 order
+/// The six faces of a hexahedron (0-based VTK indices), in 1-based vertex numbers
 /// (1234), (5678), (1265), (4378), (1485), (2376) — the same table the quality module's
 /// planarity test uses ([`unamalla_mesh::quality::hex::PLANARITY_FACES`]).
 pub const HEX_QUAD_FACES: [[usize; 4]; 6] = unamalla_mesh::quality::hex::PLANARITY_FACES;
@@ -193,7 +197,7 @@ impl Scaling3 {
 }
 
 /// Signed cosine `k = (AB × AD)·AC/(‖AB × AD‖‖AC‖)` of the face `p = [A, B, C, D]`
-/// (seed 004 (4.2)); 0 for a degenerate face.
+/// ([Cortés Aguirre 2012, (4.2)]); 0 for a degenerate face.
 pub fn face_coplanarity_cos(p: [DVec3; 4]) -> f64 {
     let (u, v, w) = (p[1] - p[0], p[3] - p[0], p[2] - p[0]);
     let n = u.cross(v);
@@ -206,7 +210,8 @@ pub fn face_coplanarity_cos(p: [DVec3; 4]) -> f64 {
 }
 
 /// Max `|cos|` of [`face_coplanarity_cos`] over the four cyclic relabellings of the face
-/// (the leave-one-out reading of the thesis' check, seed 004 digest §4.1 \[I\]).
+/// (our leave-one-out reading of the "six combinations of the four vertices" that
+/// [Cortés Aguirre 2012, §4.1] checks).
 pub fn face_planarity_max_cos(p: [DVec3; 4]) -> f64 {
     (0..4)
         .map(|r| face_coplanarity_cos([p[r], p[(r + 1) & 3], p[(r + 2) & 3], p[(r + 3) & 3]]).abs())
@@ -425,7 +430,8 @@ impl HexTopology {
     }
 
     /// Max over the six faces of the interior cells of [`face_planarity_max_cos`] at `x`, and the
-    /// number of interior cells with some face above `tol` (non-hexahedral cells, seed 004 §9).
+    /// number of interior cells with some face above `tol` (non-hexahedral cells, as counted in
+    /// [Cortés Aguirre 2012, Table 3.3, Table 4.3]).
     pub fn planarity_report(&self, x: &[f64], tol: f64) -> (f64, usize) {
         let mut worst = 0.0f64;
         let mut bad = 0;
@@ -865,7 +871,7 @@ fn face_term(
 }
 
 /// The 3D functional `h_scale·Σ_cells Σ_tets λφ_ω(V) + C·Σ_interior cells Σ_faces k²`
-/// (seed 004 (3.27) and (4.4)); either term can be switched off.
+/// ([Cortés Aguirre 2012, (3.27), (4.4)]); either term can be switched off.
 #[derive(Debug, Clone)]
 pub struct HexFunctional {
     topo: Arc<HexTopology>,
@@ -1157,7 +1163,7 @@ impl Problem for HexFunctional {
         self.topo.hessian_pattern()
     }
 
-    /// Node-block assembly (issue #10): per cell the Hessian w.r.t. its eight vertices is built
+    /// Node-block assembly: per cell the Hessian w.r.t. its eight vertices is built
     /// as 8×8 closed-form 3×3 blocks (`tet_term_blocks`, `face_term_blocks`, see the module docs) and added at
     /// the CSR positions precomputed once with the pattern ([`HexTopology::block_slots`]).
     /// Cells run in the deterministic chunk colouring of `assembly` (bit-identical for any
@@ -1312,8 +1318,8 @@ impl Problem for HexFunctional {
 }
 
 /// The harmonic energy `E = λ/V` of a mesh under the readings of the thesis's discretisation
-/// that could explain a reported value (Cortés Aguirre 2012, §3.2 eq. (3.21)–(3.22) and
-/// (3.27); the sphere of §3.4.3 ends at `f = 2.26543`). All are evaluated at `ω → 0`, i.e.
+/// that could explain a reported value ([Cortés Aguirre 2012, §3.2, (3.21)–(3.22), (3.27)]; the
+/// sphere of §3.4.3 ends at `f = 2.26543`). All are evaluated at `ω → 0`, i.e.
 /// where `H_ω` *is* the energy (`φ_ω(V) = 1/V` for `V ≥ ω`); `E ≥ 1` per tetrahedron (AM–GM),
 /// `= 1` iff its Jacobian is a similarity. See [`energy_variants`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -1340,7 +1346,7 @@ pub struct EnergyVariants {
 }
 
 /// Evaluates [`EnergyVariants`] on the cells `cells` (eight vertices each, VTK order) with
-/// the Jacobian scaling `scaling` (seed 004 §3.2; [`Scaling3`]).
+/// the Jacobian scaling `scaling` ([Cortés Aguirre 2012, §3.2]; [`Scaling3`]).
 ///
 /// Hand values on a mesh of congruent cubes (every Jacobian a similarity): `printed = 1`,
 /// `per_decomposition = volume_weighted = 2`, `interior_raw = (8 + 2√2)/10`.
@@ -1451,7 +1457,7 @@ mod tests {
         })
     }
 
-    /// Hand values of [`energy_variants`] (Cortés Aguirre 2012, (3.22) and its readings).
+    /// Hand values of [`energy_variants`] ([Cortés Aguirre 2012, (3.22)] and its readings).
     #[test]
     fn energy_variants_hand_values() {
         // congruent cubes of side 0.25: every tetrahedron Jacobian is a similarity, E = 1

@@ -5,7 +5,7 @@
 //!
 //! * the four **corner triangles** of a counter-clockwise quad `[v₀, v₁, v₂, v₃]`: at corner `k`
 //!   the corner is `P = v_k`, `Q = v_{k+1}`, `R = v_{k−1}` (indices mod 4), `a = Q − P`,
-//!   `b = R − P` (seed 000 digest §5.5, Fig 6.12; seed 001 digest §1);
+//!   `b = R − P` ([Méndez 2023, §6.4.2, Fig 6.12]; [González Flores, (2.53), Fig 2.19]);
 //! * the **diagonal pair** `a = v₂ − v₀`, `b = v₃ − v₁` (only for the Castillo cell area:
 //!   `det(a, b) = 2·area(cell)`), tagged with [`DIAGONAL`].
 //!
@@ -29,7 +29,7 @@
 //!   weighted sum `Σᵢ wᵢ·Eᵢ` or a cell-weighted expression `c(cell)·E`, built flat by its
 //!   methods (sums, convex combinations, normalizations, per-cell weights). The evaluator of
 //!   [`crate::quad`] inspects the expression once and picks a fused kernel for the sums it
-//!   knows (today `w₁F_AO + w₂H_ω`, seed 000 (6.8)), the general recursive one otherwise.
+//!   knows (today `w₁F_AO + w₂H_ω`, [Méndez 2023, (6.8)]), the general recursive one otherwise.
 
 /// Index of α in [`Partials`] arrays.
 pub const S_ALPHA: usize = 0;

@@ -11,34 +11,36 @@
 //! Each counter-clockwise quad `[v₀, v₁, v₂, v₃]` has four corner triangles: at corner `k`,
 //! `P = v_k`, legs `a = v_{k+1} − P`, `b = v_{k−1} − P`, and
 //! `α = det(a, b)` (doubled signed area), `l = |a|² + |b|²`, `o = a·b`
-//! (seed 000 digest §5.5 Table 6.2 and Fig 6.12; seed 001 digest §1). A cell is convex iff its
+//! ([Méndez 2023, §6.4.2, Table 6.2, Fig 6.12]; [González Flores, (2.53), Fig 2.19]; the
+//! references are listed in `docs/references.md` of the repository). A cell is convex iff its
 //! four α are positive; `Σα = 4·area(Ω)`, `ᾱ = Σα/N`. A functional is `F = Σ_q f(α_q, l_q, o_q)`
 //! with `f` a weighted sum of the leaf kernels below ([`kernel`]):
 //!
 //! | kernel | term | source |
 //! |---|---|---|
-//! | [`Length`] / [`WeightedLength`] | `l`; `2(ω‖e_ξ‖² + (1−ω)‖e_η‖²)` | seed 000 T6.2; seed 001 (1.10–1.11) |
-//! | [`Area`] (t-Area) | `α²` | seed 001 (3.33) |
-//! | [`CastilloArea`] | `A_cell²` | seed 001 (3.30) |
-//! | [`A4P`] | `(α − ᾱ)⁴` | seed 001 (3.70) |
-//! | [`Orthogonality`] | `o²` | seed 000 T6.2 |
-//! | [`AreaOrthogonality`] | `½(α² + o²) = ½‖a‖²‖b‖²` (corner apex, seed 000 erratum 10) | seed 000 T6.2 |
-//! | [`Smoothness`] (Winslow) | `l/α`, non-uniform spacing `(ρ‖e_ξ‖² + ρ⁻¹‖e_η‖²)/α` | seed 001 (2.55), §2.2 |
-//! | [`RegularizedSmoothness`] | `l·φ̃(α)`, pole at `−ε_c`, `ε_c = ᾱ/2` | seed 001 §2.3, erratum 2 |
-//! | [`RegularizedInverseArea`] | `φ̃(α)` | seed 001 (3.71) |
-//! | [`GenericArea`] | any `f(α)` with `f′`, `f″` | seed 001 (3.54–3.60) |
-//! | [`KSmoothness`] | `(l + 2k)/(k + α)`, C² quadratic below `α̂` | seed 001 (4.37–4.41), erratum 6 |
-//! | [`KArea`] | `1/(k + α)`, C² quadratic below `α̂` | seed 001 (4.23), (4.43) |
-//! | [`SOmegaEps`] | `f(ω(α/ᾱ − ε))`, `f` of (56) | seed 003 §5.3 (55–56), erratum 13 |
-//! | [`HOmega`] | `l·φ_ω(α)`, `φ_ω = 1/α` (α ≥ ω), `(2ω − α)/ω²` below (C¹) | seed 000 §5.5, erratum 10 |
-//! | [`IvanenkoConvex`] | `((ε − α)₊)²` (zero iff every `α ≥ ε`) | González Flores, UNAMALLA thesis, §2.2 (2.50), after Ivanenko |
+//! | [`Length`] / [`WeightedLength`] | `l`; `2(ω‖e_ξ‖² + (1−ω)‖e_η‖²)` | [Méndez 2023, Table 6.2]; [González Flores, (1.10)–(1.11)] |
+//! | [`Area`] (t-Area) | `α²` | [González Flores, (3.33)] |
+//! | [`CastilloArea`] | `A_cell²` | [González Flores, (3.30)] |
+//! | [`A4P`] | `(α − ᾱ)⁴` | [González Flores, (3.70)] |
+//! | [`Orthogonality`] | `o²` | [Méndez 2023, Table 6.2] |
+//! | [`AreaOrthogonality`] | `½(α² + o²) = ½‖a‖²‖b‖²` (apex at the corner; the table prints the wrong apex) | [Méndez 2023, Table 6.2] |
+//! | [`Smoothness`] (Winslow) | `l/α`, non-uniform spacing `(ρ‖e_ξ‖² + ρ⁻¹‖e_η‖²)/α` | [González Flores, (2.55), (2.78)–(2.93)] |
+//! | [`RegularizedSmoothness`] | `l·φ̃(α)`, pole at `−ε_c`, `ε_c = ᾱ/2` | [González Flores, §2.4, (2.61)–(2.65)], switch on `α = det` |
+//! | [`RegularizedInverseArea`] | `φ̃(α)` | [González Flores, (3.71)] |
+//! | [`GenericArea`] | any `f(α)` with `f′`, `f″` | [González Flores, (3.54)–(3.60)] |
+//! | [`KSmoothness`] | `(l + 2k)/(k + α)`, C² quadratic below `α̂` | [González Flores, (4.37)–(4.41)], `α̂` not as printed in (4.42) |
+//! | [`KArea`] | `1/(k + α)`, C² quadratic below `α̂` | [González Flores, (4.23), (4.43)] |
+//! | [`SOmegaEps`] | `f(ω(α/ᾱ − ε))`, `f` of (56) | [Abelló et al., §2.2, (55)–(56)], scale-invariant argument |
+//! | [`HOmega`] | `l·φ_ω(α)`, `φ_ω = 1/α` (α ≥ ω), `(2ω − α)/ω²` below (C¹) | [Méndez 2023, §6.4.2], continuous `φ_ω` |
+//! | [`IvanenkoConvex`] | `((ε − α)₊)²` (zero iff every `α ≥ ε`) | [González Flores, (2.50)], after Ivanenko |
 //!
 //! Every leaf is a variant of [`Leaf`] (the leaf list is written once, in [`kernel::expr`]).
 //! A functional is one [`KernelExpr`], a weighted sum of (possibly cell-weighted) leaves:
 //! `f = Σᵢ wᵢ·Eᵢ` with each `Eᵢ` a leaf `fᵢ` or `c(cell)·E` (per-cell weights `c`, the boundary
-//! density `w` of seed 000 (6.9)), built with normalizations ([`KernelExpr::normalized`], `F/(N·f(ideal triangle))`, seed 001
-//! §3.1), weighted sums ([`KernelExpr::weighted_sum`], [`KernelExpr::convex`], e.g. seed 000
-//! (6.8) `(1−σ)F_AO + σH_ω`) and per-cell weights ([`KernelExpr::cell_weighted`]). User
+//! density `w` of [Méndez 2023, (6.9)]), built with normalizations ([`KernelExpr::normalized`],
+//! `F/(N·f(ideal triangle))`, [González Flores, §5.1]), weighted sums
+//! ([`KernelExpr::weighted_sum`], [`KernelExpr::convex`], e.g. [Méndez 2023, (6.8)]
+//! `(1−σ)F_AO + σH_ω`) and per-cell weights ([`KernelExpr::cell_weighted`]). User
 //! kernels implement [`TriKernel`] and enter as [`Leaf::Custom`] (e.g. a [`GenericArea`]).
 //!
 //! Gradients and Hessians come from one generic chain rule through `(α, |a|², |b|², o)`
@@ -52,12 +54,13 @@
 //! order. The tests keep a straightforward per-triangle path and check that both agree.
 //!
 //! ## 3D: hexahedra
-//! [`HexFunctional`] ([`hex`]): the quasi-harmonic `H_ω` over the 10 tetrahedra of each
-//! hexahedron (seed 004 digest §3.2: decompositions A = 1245, 3427, 6572, 8547 + 7425 and
-//! B = 2316, 4138, 5861, 7683 + 1386, corner and interior Jacobian stencils, optional parametric
-//! scaling), `H_ω = 1/(10N_c) ΣΣ λ φ_ω(V)`, `λ = (‖r_ξ‖² + ‖r_η‖² + ‖r_ζ‖²)^{3/2}/3^{3/2}` (3.27);
-//! and the face-coplanarity penalty `C·Σ k²`, `k = (AB × AD)·AC/(‖AB × AD‖‖AC‖)` over the six
-//! faces of interior cells (seed 004 §4, (4.2)–(4.4)).
+//! [`HexFunctional`] ([`hex`]): the quasi-harmonic `H_ω` over the 10 tetrahedra of each hexahedron
+//! ([Cortés Aguirre 2012, §3.2]: decompositions A = 1245, 3427, 6572, 8547 + 7425 and B = 2316,
+//! 4138, 5861, 7683 + 1386, corner and interior Jacobian stencils, optional parametric scaling; the
+//! list as completed in [`hex`]), `H_ω = 1/(10N_c) ΣΣ λ φ_ω(V)`,
+//! `λ = (‖r_ξ‖² + ‖r_η‖² + ‖r_ζ‖²)^{3/2}/3^{3/2}` (3.27); and the face-coplanarity penalty
+//! `C·Σ k²`, `k = (AB × AD)·AC/(‖AB × AD‖‖AC‖)` over the six faces of interior cells
+//! ([Cortés Aguirre 2012, §4.1, (4.2)–(4.4)]).
 //!
 //! ## The optimization interface
 //! [`Problem`] (value, value + gradient, Hessian pattern and refresh, Hessian-vector product,

@@ -4,10 +4,10 @@
 
 use crate::csr::Csr;
 
-/// Value, gradient and Hessian of a functional restricted to one free node (the other nodes
-/// held at their current positions): the model used by pointwise Newton (seed 001 digest §3,
-/// García). Only the first `dim` entries of `grad` and the leading `dim × dim` block of `hess`
-/// are meaningful (2 for quad meshes, 3 for hex meshes); the rest is zero.
+/// Value, gradient and Hessian of a functional restricted to one free node (the other nodes held at
+/// their current positions): the model used by pointwise Newton ([González Flores, §B.5.2], after
+/// García). Only the first `dim` entries of `grad` and the leading `dim × dim` block of `hess` are
+/// meaningful (2 for quad meshes, 3 for hex meshes); the rest is zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LocalModel {
     /// Sum of the terms that involve the node (its incident triangles / tetrahedra / faces).

@@ -16,8 +16,7 @@
 //!   `+∂f/∂a`, `n₀` receives `−∂f/∂a` (and likewise for `b`), and the Hessian block of nodes
 //!   `(i, j)` is `Σ σᵢσⱼ ∂²f/∂Lᵢ∂Lⱼ` over the legs `Lᵢ ∋ i`, `Lⱼ ∋ j` with signs `σ = ±1`.
 //!
-//! This one exact path serves every kernel (seed 001 digest §2.4 derivative kit, checked against
-//! finite differences in the tests).
+//! This one exact path serves every kernel (checked against finite differences in the tests).
 //!
 //! # Two implementations of the same formulas
 //! [`Problem`] for [`QuadFunctional`] runs the fast evaluator of the private `lanes` submodule
@@ -27,7 +26,7 @@
 //! `A = H_aa`, `B = H_ab`, `C = H_bb`). The per-triangle path above is kept in a test-only
 //! submodule (`reference`) as the oracle: the tests check that the two agree to rounding for
 //! every kind of expression. The kernel the fast path runs is chosen once per expression
-//! (private `plan` submodule): `w₁F_AO + w₂H_ω` (seed 000 (6.8)) runs a fused, monomorphized
+//! (private `plan` submodule): `w₁F_AO + w₂H_ω` ([Méndez 2023, (6.8)]) runs a fused, monomorphized
 //! two-leaf kernel, anything else the expression's own evaluation (one `match` per node, cell
 //! and term).
 
@@ -58,7 +57,8 @@ const LEGS: [[usize; 4]; 5] = [
     [0, 2, 1, 3],
 ];
 
-/// Summary of the corner-triangle measures of a quad mesh (seed 001 digest §1).
+/// Summary of the corner-triangle measures of a quad mesh
+/// ([González Flores, §4.1, (3.53), (4.31)]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlphaSummary {
     /// `α₋ = min α`.
@@ -192,7 +192,7 @@ impl QuadTopology {
         self.asm.colors.len()
     }
     /// `ᾱ = Σα/N` of the mesh given at construction (`= 4·area(Ω)/N` for a mesh with fixed
-    /// boundary; independent of the interior nodes, seed 001 digest §1).
+    /// boundary; independent of the interior nodes, [González Flores, (3.53), (4.31)]).
     pub fn alpha_bar(&self) -> f64 {
         self.alpha_bar
     }
@@ -320,10 +320,10 @@ impl QuadTopology {
         s
     }
 
-    /// Per-cell density weights for seed 000 (6.9): `density` on the cells within `layers` cell
-    /// layers of the mesh boundary (layer 1 = cells touching a boundary node, where boundary
-    /// nodes are those on edges used by one cell), 1 elsewhere. The thesis uses an integer
-    /// density below 10 and does not give the band width.
+    /// Per-cell density weights for [Méndez 2023, (6.9)]: `density` on the cells within `layers`
+    /// cell layers of the mesh boundary (layer 1 = cells touching a boundary node, where boundary
+    /// nodes are those on edges used by one cell), 1 elsewhere. The thesis uses an integer density
+    /// below 10 and does not give the band width.
     pub fn boundary_density(&self, density: f64, layers: usize) -> Vec<f64> {
         let n = self.asm.num_nodes;
         let mut edges: std::collections::HashMap<(u32, u32), u32> =
@@ -736,7 +736,7 @@ macro_rules! with_plan {
     };
 }
 
-// After `with_plan!` (textual macro scope): the PSD-projected model Hessian (issue #4).
+// After `with_plan!` (textual macro scope): the PSD-projected model Hessian.
 pub mod psd;
 #[cfg(test)]
 mod reference;

@@ -38,7 +38,7 @@ fn sum_of_alphas_is_four_times_the_area_even_when_folded() {
 #[test]
 fn right_isosceles_triangle_minimizes_l_over_alpha() {
     // one triangle: P = 0, Q = a, R = b; (|a|² + |b|²)/det(a, b) ≥ 2 with equality iff
-    // b = a rotated by +90° (seed 001 (2.70–2.77)).
+    // b = a rotated by +90° ([González Flores, (2.70)–(2.77)]).
     let k = Smoothness::new();
     let term = |a: DVec2, b: DVec2| {
         let s = TriScalars {
@@ -81,7 +81,8 @@ fn right_isosceles_triangle_minimizes_l_over_alpha() {
 
 #[test]
 fn uniform_area_grid_is_a_critical_point_of_any_area_functional() {
-    // a uniform grid of a parallelogram: every corner triangle has α = ᾱ (seed 001 Prop 3.1)
+    // a uniform grid of a parallelogram: every corner triangle has α = ᾱ
+    // ([González Flores, Prop 3.1])
     let g = StructuredGrid2::from_fn(6, 5, |i, j| {
         DVec2::new(
             1.5 * i as f64 + 0.7 * j as f64,
@@ -498,12 +499,12 @@ fn a_hessian_of_another_pattern_is_rejected() {
 ///   `8(1 − c)(3 + c)` (≈ `16θ²`, second order).
 ///
 /// So smooth `(1, −1)` waves cost `(1 − c)/(3 + c) ≈ θ²/8` of the other polarization, and only
-/// `H_ω` bounds them from below. `H_ω` is isotropic: at the identity Winslow's `l/α` has the
-/// second variation `|∇u|² − 2 det ∇u` (expand `(2 + 2 div u + |∇u|²)/(1 + div u + det ∇u)`),
-/// and `det ∇u` sums to zero with the boundary fixed, so both quotients are equal — the reason the (6.8)
-/// optimum at σ = 0.1 is so flat (docs/benchmarks.md, issue #4). The waves are multiplied by
-/// the envelope `sin(πi/(n−1))·sin(πj/(n−1))` so that they vanish on the fixed boundary; its
-/// frequency `π/(n−1)` is small against θ, hence the 5 % tolerance.
+/// `H_ω` bounds them from below. `H_ω` is isotropic: at the identity Winslow's `l/α` has the second
+/// variation `|∇u|² − 2 det ∇u` (expand `(2 + 2 div u + |∇u|²)/(1 + div u + det ∇u)`), and `det ∇u`
+/// sums to zero with the boundary fixed, so both quotients are equal — the reason the (6.8) optimum
+/// at σ = 0.1 is so flat (docs/benchmarks.md, "Why 1000² in 5 s is out of reach at σ = 0.1"). The
+/// waves are multiplied by the envelope `sin(πi/(n−1))·sin(πj/(n−1))` so that they vanish on the
+/// fixed boundary; its frequency `π/(n−1)` is small against θ, hence the 5 % tolerance.
 #[test]
 fn area_orthogonality_hessian_is_weak_for_diagonal_shear_waves() {
     let n = 161;

@@ -1,5 +1,5 @@
-//! Ivanenko's convex-mesh functional `Σ ((ε − α)₊)²` (González Flores, UNAMALLA thesis, §2.2
-//! eq. (2.50)) on a 3 × 3-node grid whose only free node is moved by hand.
+//! Ivanenko's convex-mesh functional `Σ ((ε − α)₊)²` ([González Flores, (2.50)]) on a 3 × 3-node
+//! grid whose only free node is moved by hand.
 //!
 //! Grid: nodes `(i, j)`, `i, j ∈ {0, 1, 2}`, on the square `[0, 2]²`; the centre node
 //! `C = (1 + t, 1)` is free. Of the 16 corner triangles, the 4 at the outer corners and the 4 at

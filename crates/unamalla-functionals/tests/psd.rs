@@ -1,4 +1,4 @@
-//! The PSD-projected model Hessian (`QuadFunctional::hessian_psd`, issue #4): it is positive
+//! The PSD-projected model Hessian (`QuadFunctional::hessian_psd`): it is positive
 //! semidefinite for any grid and kernel, and equal to the exact Hessian where every triangle's
 //! leg Hessian is already positive definite.
 #![allow(clippy::needless_range_loop)]

@@ -8,7 +8,7 @@
 //! * a weighted sum `E = Σᵢ wᵢ·Eᵢ` ([`KernelExpr::Sum`]), evaluated as written: an accumulator
 //!   starting at 0 receives `wᵢ·Eᵢ` in order;
 //! * a cell-weighted expression `E = c(cell)·E₁` ([`KernelExpr::CellWeighted`], the boundary
-//!   density `w` of seed 000 (6.9); a cell past the end of the weights has weight 1).
+//!   density `w` of [Méndez 2023, (6.9)]; a cell past the end of the weights has weight 1).
 //!
 //! A leaf that uses the diagonal pair ([`CastilloArea`]) is evaluated on the diagonal pair only,
 //! all others on the four corner triangles ([`TriKernel::terms`]); a sum skips the parts that do
@@ -171,7 +171,7 @@ impl Leaf {
 
     /// The value of one corner-triangle term on the **ideal** triangle of a mesh with mean `ᾱ`
     /// (right isosceles with legs `√ᾱ`: `α = ᾱ`, `la = lb = ᾱ`, `o = 0`), used as the
-    /// normalization constant per triangle (seed 001 digest §3.1, seed 000 Obs 6.8). For
+    /// normalization constant per triangle ([González Flores, §5.1]; [Méndez 2023, Obs 6.8]). For
     /// functionals whose ideal value is 0 (orthogonality, A4P) the conventional scale `ᾱ²`
     /// resp. `ᾱ⁴` is returned. `None` for a custom kernel (no natural scale).
     pub fn ideal_term(&self, alpha_bar: f64) -> Option<f64> {
@@ -248,8 +248,10 @@ impl KernelExpr {
         KernelExpr::Sum(parts.into_iter().collect())
     }
 
-    /// `σ·a + (1−σ)·b` (σ is the weight of the first functional, seed 001 erratum 7; seed 000
-    /// (6.8) is `convex(1−σ, F_AO, H_ω)`), kept flat as [`weighted_sum`](Self::weighted_sum).
+    /// `σ·a + (1−σ)·b` (σ is the weight of the first functional, as in
+    /// [González Flores, Table 5.1, Table 5.2, (5.19)–(5.20)], although its (5.12) states the
+    /// opposite; [Méndez 2023, (6.8)] is `convex(1−σ, F_AO, H_ω)`), kept flat as
+    /// [`weighted_sum`](Self::weighted_sum).
     pub fn convex(sigma: f64, a: KernelExpr, b: KernelExpr) -> Result<KernelExpr, FunctionalError> {
         if !(0.0..=1.0).contains(&sigma) {
             return Err(FunctionalError::InvalidParameter {
@@ -293,7 +295,7 @@ impl KernelExpr {
     }
 
     /// The normalized functional `F / (N·ideal_term(ᾱ))` for `N` corner triangles, so that it is
-    /// 1 on the ideal grid (seed 001 §5.1: e.g. area `Σα²/(Nᾱ²)`, length `Σl/(2Nᾱ)`,
+    /// 1 on the ideal grid ([González Flores, §5.1]: e.g. area `Σα²/(Nᾱ²)`, length `Σl/(2Nᾱ)`,
     /// k-smoothness `Σ(l+2k)/(k+α)/(2N)`, k-area `(k+ᾱ)/N·Σ1/(k+α)`).
     pub fn normalized(
         self,

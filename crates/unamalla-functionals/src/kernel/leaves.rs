@@ -67,8 +67,9 @@ fn phi_omega_lanes(omega: f64, a: &[f64; 4], second: bool) -> [[f64; 4]; 3] {
 // ---------------------------------------------------------------------------------------------
 // scalar functions of one variable: [f, f', f'']
 
-/// `φ_ω` of seed 000 §5.5 with the C¹ correction of erratum 10 (seed 004 (3.26)):
-/// `1/α` for `α ≥ ω`, `(2ω − α)/ω²` (the tangent of `1/α` at `ω`) below. Returns `[φ, φ′, φ″]`.
+/// `φ_ω` of [Méndez 2023, §6.4.2] in the C¹ form of [Cortés Aguirre 2012, (3.26)]: `1/α` for
+/// `α ≥ ω`, `(2ω − α)/ω²` (the tangent of `1/α` at `ω`) below. (Méndez prints `2(ω − α)/ω²`
+/// below `ω`, which jumps from 0 to `1/ω` at `α = ω`.) Returns `[φ, φ′, φ″]`.
 #[inline(always)]
 pub fn phi_omega(omega: f64, a: f64) -> [f64; 3] {
     // both branches are computed and selected (no data-dependent jump in the hot loop)
@@ -82,9 +83,11 @@ pub fn phi_omega(omega: f64, a: f64) -> [f64; 3] {
     ]
 }
 
-/// Barrera's regularized `1/α` (seed 001 digest §2.3 and erratum 2, det convention):
-/// `1/α` for `α ≥ ε_c`, `4ε_c/(α + ε_c)²` for `−ε_c < α < ε_c` (C¹ at `ε_c`, pole moved to
-/// `−ε_c`), `+∞` (derivatives NaN) for `α ≤ −ε_c`. Returns `[φ, φ′, φ″]`.
+/// Barrera's regularized `1/α` ([González Flores, §2.4, (2.61)–(2.64)]), with `α = det(a, b)`
+/// (twice the area): `1/α` for `α ≥ ε_c`, `4ε_c/(α + ε_c)²` for `−ε_c < α < ε_c` (C¹ at `ε_c`,
+/// pole moved to `−ε_c`), `+∞` (derivatives NaN) for `α ≤ −ε_c`. (2.64) is printed with `α` the
+/// area and the switch at `α ≥ ε_c`; the function is C¹ only with the switch on the doubled area,
+/// as here. Returns `[φ, φ′, φ″]`.
 #[inline(always)]
 pub fn phi_regularized(eps_c: f64, a: f64) -> [f64; 3] {
     if a >= eps_c {
@@ -104,7 +107,8 @@ pub fn phi_regularized(eps_c: f64, a: f64) -> [f64; 3] {
 }
 
 /// `1/(k + α)` with the optional C² quadratic continuation below the matching point `α̂`
-/// (seed 001 digest §2.5 (4.40–4.43) and erratum 6): for `α < α̂` it is the second-order Taylor
+/// ([González Flores, §4.6.3, (4.40)–(4.43)]; for the choice of `α̂` see
+/// [`recommended_alpha_hat`]): for `α < α̂` it is the second-order Taylor
 /// polynomial at `α̂`, `c + b(α−α̂) + a(α−α̂)²` with `c = 1/(k+α̂)`, `b = −1/(k+α̂)²`,
 /// `a = 1/(k+α̂)³`. Without `α̂` it is `+∞` (derivatives NaN) for `k + α ≤ 0`.
 #[inline(always)]
@@ -128,8 +132,8 @@ pub fn inv_k(k: f64, alpha_hat: Option<f64>, a: f64) -> [f64; 3] {
     [r, -r * r, 2.0 * r * r * r]
 }
 
-/// The function (56) of seed 003 (seed 000 §5.5 `φ`): `1/t` for `t ≥ 1`, `(t−1)(t−2)+1` below
-/// (C² at 1, finite everywhere). Returns `[f, f′, f″]`.
+/// The function (56) of [Abelló et al., §2.2] (`φ` of [Méndez 2023, §6.4.2]): `1/t` for `t ≥ 1`,
+/// `(t−1)(t−2)+1` below (C² at 1, finite everywhere). Returns `[f, f′, f″]`.
 #[inline(always)]
 pub fn s_function(t: f64) -> [f64; 3] {
     if t >= 1.0 {
@@ -224,7 +228,7 @@ fn leg_weights(corner: u8, wxi: f64, weta: f64) -> (f64, f64) {
 // ---------------------------------------------------------------------------------------------
 // classic kernels
 
-/// Length `F_L`: `l = |a|² + |b|²` (seed 000 Table 6.2; seed 001 (1.10)).
+/// Length `F_L`: `l = |a|² + |b|²` ([Méndez 2023, Table 6.2]; [González Flores, (1.10)]).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Length;
 impl TriKernel for Length {
@@ -238,8 +242,9 @@ impl TriKernel for Length {
     }
 }
 
-/// Weighted length (seed 001 (1.11), Ojeda): `2(ω|e_ξ|² + (1−ω)|e_η|²)` per corner triangle,
-/// `0 ≤ ω ≤ 1`; `ω = ½` gives [`Length`]. (The factor 2 is ours, so that ω = ½ reproduces `l`.)
+/// Weighted length ([González Flores, (1.11)], after Ojeda): `2(ω|e_ξ|² + (1−ω)|e_η|²)` per corner
+/// triangle, `0 ≤ ω ≤ 1`; `ω = ½` gives [`Length`]. (The factor 2 is ours, so that ω = ½ reproduces
+/// `l`.)
 #[derive(Debug, Clone, Copy)]
 pub struct WeightedLength {
     omega: f64,
@@ -269,7 +274,7 @@ impl TriKernel for WeightedLength {
     }
 }
 
-/// Area / t-Area (Barrera–Pérez, seed 001 (3.33)): `α²`.
+/// Area / t-Area (Barrera–Pérez, [González Flores, (3.33)]): `α²`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Area;
 impl TriKernel for Area {
@@ -283,8 +288,8 @@ impl TriKernel for Area {
     }
 }
 
-/// Castillo cell area (seed 001 (3.30–3.31)): `Σ_cells A²`, `A = ½ det(v₂−v₀, v₃−v₁)` the signed
-/// cell area; evaluated on the diagonal leg pair as `α_d²/4`.
+/// Castillo cell area ([González Flores, (3.30)–(3.31)]): `Σ_cells A²`, `A = ½ det(v₂−v₀, v₃−v₁)`
+/// the signed cell area; evaluated on the diagonal leg pair as `α_d²/4`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct CastilloArea;
 impl TriKernel for CastilloArea {
@@ -307,7 +312,7 @@ impl TriKernel for CastilloArea {
     }
 }
 
-/// A4P (Tinoco, seed 001 (3.70)): `(α − ᾱ)⁴`.
+/// A4P (Tinoco, [González Flores, (3.70)]): `(α − ᾱ)⁴`.
 #[derive(Debug, Clone, Copy)]
 pub struct A4P {
     alpha_bar: f64,
@@ -333,7 +338,9 @@ impl TriKernel for A4P {
     }
 }
 
-/// Orthogonality `F_O`: `o² = (a·b)²` (seed 000 Table 6.2, corner apex per seed 003 erratum 11).
+/// Orthogonality `F_O`: `o² = (a·b)²` with the apex at the corner ([Méndez 2023, Table 6.2];
+/// [Abelló et al., §2.2] prints `o` with its apex at the end of a leg, which is not 0 on a
+/// square).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Orthogonality;
 impl TriKernel for Orthogonality {
@@ -358,8 +365,8 @@ impl TriKernel for Orthogonality {
 }
 
 /// Area-orthogonality `F_AO`: `½(α² + o²)`, evaluated as `½|a|²|b|²` — equal by Lagrange's
-/// identity with the apex at the **corner** (seed 000 digest §5.5 note and erratum 10: the
-/// printed `½‖r−p‖²‖q−p‖²` has the wrong apex).
+/// identity with the apex at the **corner** (the `½‖r−p‖²‖q−p‖²` printed in
+/// [Méndez 2023, Table 6.2] has the wrong apex).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct AreaOrthogonality;
 impl TriKernel for AreaOrthogonality {
@@ -415,8 +422,8 @@ impl TriKernel for AreaOrthogonality {
     }
 }
 
-/// Per-cell logical spacing weights for Winslow on a non-uniform logical grid (seed 001 digest
-/// §2.2, (2.78–2.93)): cell `c` has `ρ_c = Δη_c/Δξ_c`, and the corner term becomes
+/// Per-cell logical spacing weights for Winslow on a non-uniform logical grid
+/// ([González Flores, (2.78)–(2.93)]): cell `c` has `ρ_c = Δη_c/Δξ_c`, and the corner term becomes
 /// `(ρ|e_ξ|² + ρ⁻¹|e_η|²)/α`.
 #[derive(Debug, Clone)]
 pub struct SpacingWeights {
@@ -461,10 +468,10 @@ impl SpacingWeights {
     }
 }
 
-/// Winslow / smoothness `F_S`: `l/α` per corner triangle (seed 001 (2.55), seed 000 Table 6.2),
-/// optionally with the non-uniform logical spacing weights ([`SpacingWeights`]). Defined for
-/// `α ≠ 0` (negative on folded triangles); use [`RegularizedSmoothness`] or [`HOmega`] on
-/// folded meshes.
+/// Winslow / smoothness `F_S`: `l/α` per corner triangle ([González Flores, (2.55)];
+/// [Méndez 2023, Table 6.2]), optionally with the non-uniform logical spacing weights
+/// ([`SpacingWeights`]). Defined for `α ≠ 0` (negative on folded triangles); use
+/// [`RegularizedSmoothness`] or [`HOmega`] on folded meshes.
 #[derive(Debug, Clone, Default)]
 pub struct Smoothness {
     weights: Option<SpacingWeights>,
@@ -494,7 +501,7 @@ impl TriKernel for Smoothness {
     }
 }
 
-/// Regularized smoothness (Barrera, seed 001 digest §2.3, erratum 2): `l·φ̃(α)` with
+/// Regularized smoothness (Barrera, [González Flores, §2.4, (2.64)]): `l·φ̃(α)` with
 /// [`phi_regularized`], pole moved to `−ε_c`; default `ε_c = ᾱ/2` (2.65).
 #[derive(Debug, Clone)]
 pub struct RegularizedSmoothness {
@@ -531,8 +538,8 @@ impl TriKernel for RegularizedSmoothness {
     }
 }
 
-/// Regularized inverse area (seed 001 (3.71) regularized "like smoothness"): `φ̃(α)` with
-/// [`phi_regularized`].
+/// Regularized inverse area ([González Flores, (3.71)], regularized "like smoothness"): `φ̃(α)`
+/// with [`phi_regularized`].
 #[derive(Debug, Clone, Copy)]
 pub struct RegularizedInverseArea {
     eps_c: f64,
@@ -556,8 +563,8 @@ impl TriKernel for RegularizedInverseArea {
     }
 }
 
-/// The general discrete area functional `Σ f(α)` (seed 001 (3.54–3.60)) for any user function
-/// returning `[f(α), f′(α), f″(α)]`.
+/// The general discrete area functional `Σ f(α)` ([González Flores, (3.54)–(3.60)]) for any user
+/// function returning `[f(α), f′(α), f″(α)]`.
 #[derive(Clone)]
 pub struct GenericArea<F> {
     f: F,
@@ -601,17 +608,18 @@ fn check_alpha_hat(k: f64, alpha_hat: Option<f64>) -> Result<(), FunctionalError
     Ok(())
 }
 
-/// The recommended matching point of the k-functionals' quadratic continuation (seed 001
-/// digest erratum 6, replacing the inconsistent printed (4.42)): `α̂ = −k + 0.015·(α₋ + k)`,
-/// 1.5 % of the gap between the pole `−k` and the current minimum `α₋` (needs `α₋ > −k`).
+/// The matching point of the k-functionals' quadratic continuation used here:
+/// `α̂ = −k + 0.015·(α₋ + k)`, 1.5 % of the gap between the pole `−k` and the current minimum `α₋`
+/// (needs `α₋ > −k`). [González Flores, (4.42)] prints `α̂ = −k + 0.015·α₋`, applied when
+/// `α̂ < 0.15·α₋`, which puts `α̂` left of the pole when `α₋ < 0`.
 pub fn recommended_alpha_hat(k: f64, alpha_minus: f64) -> f64 {
     -k + 0.015 * (alpha_minus + k)
 }
 
-/// k-Smoothness (seed 001 (4.37–4.39)): `(l + 2k)/(k + α)` on `α > −k`, with the optional C²
-/// quadratic continuation below `α̂` (4.40–4.41; the continuation multiplies `l + 2k` by the
-/// Taylor polynomial of `1/(k+α)` at `α̂`, so its constants are per triangle). Without `α̂` the
-/// value is `+∞` for `α ≤ −k` (the barrier of Prop 4.1).
+/// k-Smoothness ([González Flores, (4.37)–(4.39)]): `(l + 2k)/(k + α)` on `α > −k`, with the
+/// optional C² quadratic continuation below `α̂` (4.40–4.41; the continuation multiplies `l + 2k`
+/// by the Taylor polynomial of `1/(k+α)` at `α̂`, so its constants are per triangle). Without `α̂`
+/// the value is `+∞` for `α ≤ −k` (the barrier of Prop 4.1).
 #[derive(Debug, Clone, Copy)]
 pub struct KSmoothness {
     k: f64,
@@ -646,8 +654,8 @@ impl TriKernel for KSmoothness {
     }
 }
 
-/// k-Area (seed 001 (4.23–4.24)): `1/(k + α)`, with the optional C² continuation below `α̂`
-/// (4.43).
+/// k-Area ([González Flores, (4.23)–(4.24)]): `1/(k + α)`, with the optional C² continuation below
+/// `α̂` (4.43).
 #[derive(Debug, Clone, Copy)]
 pub struct KArea {
     k: f64,
@@ -678,9 +686,7 @@ impl TriKernel for KArea {
 /// Ivanenko's functional for a convex initial mesh: `((ε − α)₊)²` per corner triangle, with
 /// `(t)₊ = max(0, t)` and `ε > 0`.
 ///
-/// Source: the UNAMALLA thesis (UNAM, c. 2001; author presumably G. González Flores; discrete
-/// harmonic, area and adaptive functionals and the Unamalla 2.0 manual — the text available to
-/// us carries no title page), §2.2, eq. (2.50), after S. A. Ivanenko's convex-mesh functional
+/// Source: [González Flores, (2.50)], after S. A. Ivanenko's convex-mesh functional
 /// `I_{I0} = Σ_{i,j} Σ_{k=1..4} ((ε − J(Δ_ij^{(k)}))₊)²`. Here `J(Δ)` is the triangle Jacobian
 /// in this crate's convention, `α = det(a, b)` (the doubled signed area). The thesis prints the
 /// term as `(ε − J(Δ)₊)²`; the reading used here puts the positive part around the whole
@@ -735,16 +741,17 @@ impl TriKernel for IvanenkoConvex {
 /// How the argument of `f` in `S_{ω,ε}` is formed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SArgument {
-    /// `t = ω(α/ᾱ − ε)` — the scale-invariant reading recommended by the seed 003 digest
-    /// (§5.3 note, erratum 13); equals seed 000's `ω(α − ε)` after scaling so that `ᾱ = 1`.
+    /// `t = ω(α/ᾱ − ε)` — the scale-invariant reading of [Abelló et al., (55)] (as printed, the
+    /// threshold shrinks as ω grows, which does not fit the paper's "ω large ⇒ ε-convex"); equals
+    /// the `ω(α − ε)` of [Méndez 2023, §6.4.2] after scaling so that `ᾱ = 1`.
     #[default]
     ScaleInvariant,
-    /// `t = ωα − εᾱ`, eq. (55) of seed 003 as printed.
+    /// `t = ωα − εᾱ`, [Abelló et al., (55)] as printed.
     Literal,
 }
 
-/// `S_{ω,ε} = Σ f(t(α))` with `f` of (56) ([`s_function`]) (Barrera et al.; seed 003 §5.3,
-/// seed 000 §5.5). Finite for any mesh.
+/// `S_{ω,ε} = Σ f(t(α))` with `f` of (56) ([`s_function`]) (Barrera et al., as given in
+/// [Abelló et al., §2.2] and [Méndez 2023, §6.4.2]). Finite for any mesh.
 #[derive(Debug, Clone, Copy)]
 pub struct SOmegaEps {
     omega: f64,
@@ -787,7 +794,8 @@ impl TriKernel for SOmegaEps {
     }
 }
 
-/// Quasi-harmonic `H_ω` (seed 000 §5.5 with erratum 10, seed 004 §1 (1.42) read as a product):
+/// Quasi-harmonic `H_ω` ([Méndez 2023, §6.4.2] with the C¹ `φ_ω`; [Cortés Aguirre 2012, (1.42)],
+/// printed `Σλ/φ_ω`, read as the product `Σλ·φ_ω`):
 /// `l·φ_ω(α)` with [`phi_omega`]. Finite for any mesh; equals Winslow's `l/α` where `α ≥ ω`.
 #[derive(Debug, Clone, Copy)]
 pub struct HOmega {

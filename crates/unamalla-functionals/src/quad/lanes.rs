@@ -3,7 +3,7 @@
 //!
 //! # Formulas (the same exact chain rule as the reference path in [`super`])
 //! For cell `[v₀, v₁, v₂, v₃]` with edges `e_k = v_{k+1} − v_k`, corner `k` has legs
-//! `a_k = e_k`, `b_k = −e_{k−1}` (seed 000 digest §5.5 Fig 6.12, seed 001 digest §1), so the
+//! `a_k = e_k`, `b_k = −e_{k−1}` ([Méndez 2023, Fig 6.12]; [González Flores, Fig 2.19]), so the
 //! lane scalars are `α_k = a_k × b_k`, `la_k = |e_k|²`, `lb_k = |e_{k−1}|²` (the squared edge
 //! lengths are computed once per cell and shared by two corners) and `o_k = a_k·b_k`.
 //! With the kernel partials `d = ∂f/∂(α, la, lb, o)` of every lane,

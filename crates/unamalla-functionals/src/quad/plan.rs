@@ -2,7 +2,7 @@
 //! functional is built or its kernel replaced) and turned into a [`Plan`], a kernel the
 //! monomorphized lane evaluator ([`super::lanes`]) runs:
 //!
-//! * [`Plan::AoHOmega`]: `w₁F_AO + w₂H_ω` without cell weights (seed 000 (6.8), the default
+//! * [`Plan::AoHOmega`]: `w₁F_AO + w₂H_ω` without cell weights ([Méndez 2023, (6.8)], the default
 //!   smoother): the fused two-leaf kernel [`Pair`], in which both leaves are inlined;
 //! * [`Plan::General`]: any other expression, by its own recursive evaluation (one `match` per
 //!   node, term and cell, [`ExprKernel`]).
@@ -169,7 +169,7 @@ impl TriKernel for ExprKernel {
 /// (module docs).
 #[derive(Debug, Clone)]
 pub(crate) enum Plan {
-    /// `w₁F_AO + w₂H_ω` (seed 000 (6.8)), fused.
+    /// `w₁F_AO + w₂H_ω` ([Méndez 2023, (6.8)]), fused.
     AoHOmega(Pair<AreaOrthogonality, HOmega>),
     /// Any other expression.
     General(ExprKernel),

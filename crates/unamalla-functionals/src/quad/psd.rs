@@ -1,4 +1,4 @@
-//! A positive semidefinite model Hessian for the 2D functionals (issue #4): every corner
+//! A positive semidefinite model Hessian for the 2D functionals (an option): every corner
 //! triangle's Hessian is projected onto the PSD cone *before* assembly.
 //!
 //! # Formulas
@@ -20,14 +20,14 @@
 //! PSD it equals the exact Hessian (a term whose `H_u` passes an `LDLᵀ` test with positive
 //! pivots is not touched, so it is bit-identical to the reference per-triangle assembly).
 //!
-//! This is the per-element projected Newton model used for mesh and elasticity energies
-//! (e.g. Teran et al. 2005, "Robust quasistatic finite elements"): a Gauss–Newton-like
-//! convexification that keeps the exact gradient, so a Newton-type method with this model is a
-//! descent method with a positive semidefinite inner system (CG without negative curvature).
-//! Note that `F_AO = ½|a|²|b|²` (seed 000 T6.2, the first term of (6.8)) has an indefinite
-//! `H_u` for every triangle (on `span{(â,0), (0,b̂)}` it is `[[|b|², 2|a||b|], [2|a||b|, |a|²]]`,
-//! whose determinant `−3|a|²|b|²` is negative), so the model differs from the exact Hessian
-//! wherever that term has weight.
+//! This is the per-element projected Newton model used for mesh and elasticity energies (e.g.
+//! [Teran et al. 2005], "Robust quasistatic finite elements"): a Gauss–Newton-like convexification
+//! that keeps the exact gradient, so a Newton-type method with this model is a descent method with
+//! a positive semidefinite inner system (CG without negative curvature). Note that
+//! `F_AO = ½|a|²|b|²` ([Méndez 2023, Table 6.2], the first term of (6.8)) has an indefinite `H_u`
+//! for every triangle (on `span{(â,0), (0,b̂)}` it is `[[|b|², 2|a||b|], [2|a||b|, |a|²]]`, whose
+//! determinant `−3|a|²|b|²` is negative), so the model differs from the exact Hessian wherever that
+//! term has weight.
 
 use super::{leg_hessian, pair_range, scalars, scatter_leg_hessian, Plan, QuadFunctional, LEGS};
 use crate::csr::Csr;

@@ -90,7 +90,7 @@ pub fn check_problem<P: Problem>(name: &str, p: &P, x: &[f64], tol: f64) -> Resu
             if close(fd[r], dense[r][i], tol, hscale) {
                 continue;
             }
-            // φ_ω (H_ω, seed 000 digest §5.5) is only C¹: where an element sits within the
+            // φ_ω (H_ω, [Méndez 2023, §6.4.2]) is only C¹: where an element sits within the
             // step of its switch point α = ω the central difference straddles the jump of the
             // second derivative and is wrong; a smaller step on the same side must agree
             let retry = [1e-7, 1e-8]

@@ -107,7 +107,7 @@ fn kernels(topo: &QuadTopology, x: &[f64]) -> Vec<(&'static str, KernelExpr)> {
         .normalized(n, abar)
         .unwrap();
     vec![
-        // the pipeline's form of seed 000 (6.8): routed to the fused kernel
+        // the pipeline's form of [Méndez 2023, (6.8)]: routed to the fused kernel
         (
             "nested normalized ao + h-omega",
             KernelExpr::weighted_sum(vec![(0.9, ao), (0.1, h)]),
