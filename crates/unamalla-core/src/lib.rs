@@ -8,10 +8,11 @@
 //!   automatic corners ([`corners`], §4.2) or corners given by the user;
 //! * [`bspline_maps`]: bilinear and (where certified) biquadratic B-spline maps of every block
 //!   of a block mesh (seed 003, crate [`bspline`]);
-//! * [`pde`]: the elliptic PDE solver on convex structured grids and singularity-free quad
-//!   meshes (seed 001 RF12: 9-point transformed stencil, SOR with automatic ω, sparse LU with
-//!   the `direct` feature), with manufactured solutions for verification;
 //! * quality reports ([`mesh::quality::QualityReport`]) and file formats ([`io`]).
+//!
+//! The solvers that run on the meshes (elliptic PDEs on curvilinear grids, the 3D Euler
+//! equations on hexahedral grids) are the crate `unamalla-pde`, added on its own
+//! (`cargo add unamalla-pde`); this facade does not re-export it.
 //!
 //! ```
 //! use unamalla_core::{mesh::{DVec2, Region, quality::QualityReport}, single_block};
@@ -39,7 +40,6 @@ pub mod flat_corners;
 pub mod hex;
 pub mod multilevel;
 pub mod output;
-pub mod pde;
 pub mod pipeline;
 pub mod predict;
 pub mod preflight;
