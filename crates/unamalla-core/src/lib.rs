@@ -10,9 +10,10 @@
 //!   of a block mesh (seed 003, crate [`bspline`]);
 //! * quality reports ([`mesh::quality::QualityReport`]) and file formats ([`io`]).
 //!
-//! The solvers that run on the meshes (elliptic PDEs on curvilinear grids, the 3D Euler
-//! equations on hexahedral grids) are the crate `unamalla-pde`, added on its own
-//! (`cargo add unamalla-pde`); this facade does not re-export it.
+//! Two products are crates of their own, added beside this one and not re-exported by it:
+//! `unamalla-hex` (structured hexahedral meshes of logically hexahedral regions, Algorithms A
+//! and B of seed 004) and `unamalla-pde` (the solvers that run on the meshes: elliptic PDEs on
+//! curvilinear grids, the 3D Euler equations on hexahedral grids).
 //!
 //! ```
 //! use unamalla_core::{mesh::{DVec2, Region, quality::QualityReport}, single_block};
@@ -37,7 +38,6 @@ pub mod bspline_maps;
 pub mod corners;
 pub mod curves;
 pub mod flat_corners;
-pub mod hex;
 pub mod multilevel;
 pub mod output;
 pub mod pipeline;

@@ -1,3 +1,5 @@
+//! # unamalla-hex
+//!
 //! Structured hexahedral meshes on logically hexahedral regions (seed 004): built-in test
 //! regions, initial meshes, Algorithm A (convex harmonic) and Algorithm B (planar faces), the
 //! run report and the output files.
@@ -34,8 +36,8 @@
 //! (digest §10, "Approx"); each variant's documentation gives the formula used.
 //!
 //! ```
-//! use unamalla_core::hex::{run_hex, HexCase, HexRunOptions, Perturbation};
-//! use unamalla_core::optim::NullObserver;
+//! use unamalla_hex::{run_hex, HexCase, HexRunOptions, Perturbation};
+//! use unamalla_optim::NullObserver;
 //!
 //! let mut grid = HexCase::Sphere.initial_grid((8, 8, 8)).unwrap();
 //! let (amp, nc0) = Perturbation::AtLeast { cells: 5 }.apply(&mut grid, 1).unwrap();
@@ -44,6 +46,11 @@
 //! assert_eq!(rep.start.non_convex_cells, nc0);
 //! assert_eq!(rep.non_convex_cells, 0); // Algorithm A made it convex
 //! ```
+
+#![warn(missing_docs)]
+// user input (case names, face-grid files, options) reaches every function: no unwrap/expect
+// outside tests (issue #14)
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 use std::f64::consts::PI;
 use std::fmt;
