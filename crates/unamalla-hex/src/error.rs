@@ -9,6 +9,7 @@ use unamalla_optim::OptimError;
 
 /// Errors of the hexahedral pipeline.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum HexError {
     /// A generator or region check failed.
     #[error(transparent)]

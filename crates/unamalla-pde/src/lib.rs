@@ -342,6 +342,7 @@ pub struct Solution {
 
 /// Errors of the PDE solver; each names the offending coefficient, node or cell.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum PdeError {
     /// A coefficient is NaN or infinite.
     #[error("coefficient {name} = {value} is not finite")]
