@@ -30,12 +30,12 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
 use unamalla_core::decompose::DecomposeOptions;
-use unamalla_core::hex::{run_hex, HexCase, HexRunOptions};
 use unamalla_core::io::input::{load_region, LoadOptions};
 use unamalla_core::mesh::Region;
 use unamalla_core::optim::fixtures::sinusoidal;
 use unamalla_core::optim::{smooth_coarse_to_fine, CoarseToFineOptions, NullObserver};
 use unamalla_core::pipeline::{choose_layout, default_smooth_options, MeshSize, Mesher};
+use unamalla_hex::{run_hex, HexCase, HexRunOptions};
 
 fn region(name: &str) -> Region {
     let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "fixtures", "regions", name]

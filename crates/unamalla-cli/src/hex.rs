@@ -7,12 +7,12 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use unamalla_core::hex::{
+use unamalla_core::optim::drivers::CoplanarityOptions;
+use unamalla_core::optim::{NullObserver, Observer, ProgressObserver};
+use unamalla_hex::{
     read_face_dir, run_hex, write_outputs, HexAlgorithm, HexCase, HexRunOptions, HexScaling,
     Perturbation,
 };
-use unamalla_core::optim::drivers::CoplanarityOptions;
-use unamalla_core::optim::{NullObserver, Observer, ProgressObserver};
 
 /// Arguments of `unamalla hex`.
 #[derive(clap::Args, Debug)]

@@ -1,5 +1,5 @@
 //! `unamalla pde`: solve `a·U_xx + 2b·U_xy + c·U_yy + d·U = g` on a mesh file (seed 001
-//! digest §6 RF12, §7.3) with [`unamalla_core::pde`], and write the solution as VTK point data
+//! digest §6 RF12, §7.3) with [`unamalla_pde`], and write the solution as VTK point data
 //! `u`, a Geomview `MESH` surface (structured grids) and PNG/SVG colour plots.
 
 use std::path::{Path, PathBuf};
@@ -8,11 +8,11 @@ use anyhow::{bail, Context, Result};
 use unamalla_core::io::{self, VtkMesh};
 use unamalla_core::mesh::quality::quad_cell_metrics;
 use unamalla_core::mesh::{QuadMesh, StructuredGrid2};
-use unamalla_core::pde::manufactured::Manufactured;
-use unamalla_core::pde::{
+use unamalla_core::render;
+use unamalla_pde::manufactured::Manufactured;
+use unamalla_pde::{
     solve_grid, solve_quads, Equation, Method, SideValue, Solution, SolveOptions, Source,
 };
-use unamalla_core::render;
 
 /// Arguments of `unamalla pde`.
 #[derive(clap::Args, Debug)]

@@ -17,8 +17,8 @@
 //! ```
 //!
 //! [`Mesher`] runs the whole job ([`pipeline`] explains each stage and its sources): contour
-//! simplification, decomposition into four-sided blocks by cuts (Tinoco-Ruiz's
-//! thesis method, or submapping), compatible point counts across the cuts (an integer
+//! simplification, decomposition into four-sided blocks by cuts ([Méndez 2023, Ch. 4], or
+//! submapping [Ruiz-Gironés & Sarrate]), compatible point counts across the cuts (an integer
 //! program), transfinite interpolation per block, merging into one conformal mesh, and
 //! smoothing with the convexity-preserving functional
 //! `F = (1−σ)·F_AO + σ·H_ω` (area–orthogonality and the adaptive harmonic functional),
@@ -32,15 +32,16 @@
 //!   interpolation between four arc-length-resampled sides, with automatic corners
 //!   ([`corners`]) or corners given by the user;
 //! * [`bspline_maps`]: bilinear and (where certified) biquadratic B-spline maps of every block
-//!   of a block mesh (crate [`bspline`]);
-//! * [`pde`]: the elliptic PDE solver on convex structured grids and singularity-free quad
-//!   meshes (9-point transformed stencil, SOR with automatic ω, sparse LU with the `direct`
-//!   feature), with manufactured solutions for verification;
+//!   of a block mesh (crate [`bspline`], [Abelló et al.]);
 //! * quality reports ([`mesh::quality::QualityReport`]) and file formats ([`io`]).
 //!
 //! The stage crates are re-exported ([`mesh`], [`io`], [`contour`], [`decompose`],
 //! [`compat_ilp`], [`functionals`], [`optim`], [`bspline`]) together with [`glam`], whose
-//! `DVec2`/`DVec3` are the points of the whole API.
+//! `DVec2`/`DVec3` are the points of the whole API. Two products are crates of their own,
+//! added beside this one and not re-exported by it: `unamalla-hex` (structured hexahedral
+//! meshes of logically hexahedral regions, Algorithms A and B of [Cortés Aguirre 2012]) and
+//! `unamalla-pde` (elliptic PDEs on curvilinear grids, the 3D Euler equations on hexahedral
+//! grids). The sources are listed in `docs/references.md` of the repository.
 //!
 //! ```
 //! use unamalla_core::{mesh::{DVec2, Region, quality::QualityReport}, single_block};
@@ -57,17 +58,15 @@
 //! assert_eq!(report.non_convex_cells, 0);
 //! ```
 
-// user input reaches every stage: no unwrap/expect outside tests (issue #14)
+// user input reaches every stage: no unwrap/expect outside tests (docs/reliability.md)
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod bspline_maps;
 pub mod corners;
 pub mod curves;
 pub mod flat_corners;
-pub mod hex;
 pub mod multilevel;
 pub mod output;
-pub mod pde;
 pub mod pipeline;
 pub mod predict;
 pub mod preflight;
@@ -166,7 +165,7 @@ pub enum CoreError {
     /// A B-spline map could not be built or certified.
     #[error(transparent)]
     Bspline(#[from] unamalla_bspline::BsplineError),
-    /// Submapping (seed 002) failed.
+    /// Submapping [Ruiz-Gironés & Sarrate] failed.
     #[error(transparent)]
     Submap(#[from] unamalla_decompose::submap::SubmapError),
     /// The finished mesh failed the independent check ([`verify`]).

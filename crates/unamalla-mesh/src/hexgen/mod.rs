@@ -17,7 +17,8 @@
 //!
 //! The quality measures of the resulting meshes (10-tetrahedra convexity test, face
 //! planarity `|cos|`, Verdict metrics) are in [`crate::quality`]; the optimisation
-//! (Algorithms A and B) is in `unamalla-optim`.
+//! (Algorithms A and B) is in `unamalla-optim`; the hexahedral product built on both (built-in
+//! regions, face-grid files, runs, reports) is the crate `unamalla-hex`.
 
 pub mod classify;
 pub mod counting;

@@ -1,6 +1,13 @@
-//! A finite-difference solver for linear elliptic equations on curvilinear grids — the
-//! "PDE solve" application of UNAMALLA (seed 001 digest §6 RF12, §7.3 *PDE Solver Control
-//! Panel*):
+//! # unamalla-pde
+//!
+//! The solvers that run *on* the meshes of the unamalla crate family: a finite-difference
+//! solver for linear elliptic equations on curvilinear quad grids (below) and, in [`euler`], a
+//! first-order finite-volume solver of the 3D Euler equations on structured hexahedral grids
+//! (Cortés Aguirre 2012, chapter 5). The crate depends only on `unamalla-mesh` (and on `faer`
+//! with the cargo feature `direct`).
+//!
+//! The elliptic solver is the "PDE solve" application of UNAMALLA (seed 001 digest §6 RF12,
+//! §7.3 *PDE Solver Control Panel*):
 //!
 //! ```text
 //! a·U_xx + 2b·U_xy + c·U_yy + d·U = g(x, y)   in Ω,     U = U_D on ∂Ω,
@@ -53,7 +60,7 @@
 //!
 //! (The module [`euler`] holds the other application of the sources: a first-order
 //! finite-volume solver of the 3D Euler equations on hexahedral grids, Cortés Aguirre 2012,
-//! chapter 5.)
+//! chapter 5; its formulas are in its module docs.)
 //!
 //! # Meshes
 //!
@@ -105,8 +112,8 @@
 //! # Example
 //!
 //! ```
-//! use unamalla_core::mesh::{DVec2, StructuredGrid2};
-//! use unamalla_core::pde::{solve_grid, Equation, SideValue, Source, SolveOptions};
+//! use unamalla_mesh::{DVec2, StructuredGrid2};
+//! use unamalla_pde::{solve_grid, Equation, SideValue, Source, SolveOptions};
 //!
 //! // Poisson ΔU = −2 on the unit square with U = 0 on the boundary, 21 × 21 nodes.
 //! let grid = StructuredGrid2::from_fn(21, 21, |i, j| DVec2::new(i as f64 / 20.0, j as f64 / 20.0))?;
@@ -118,6 +125,10 @@
 //! assert!((centre - 0.1473).abs() < 2e-3); // series solution: 0.14734
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+
+#![warn(missing_docs)]
+// user input reaches the solvers: no unwrap/expect outside tests (issue #14)
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod direct;
 pub mod euler;
@@ -331,6 +342,7 @@ pub struct Solution {
 
 /// Errors of the PDE solver; each names the offending coefficient, node or cell.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum PdeError {
     /// A coefficient is NaN or infinite.
     #[error("coefficient {name} = {value} is not finite")]
@@ -423,7 +435,7 @@ pub enum PdeError {
         omega: f64,
     },
     /// The direct solver is not compiled in.
-    #[error("the direct solver needs the cargo feature `direct` of unamalla-core")]
+    #[error("the direct solver needs the cargo feature `direct` of unamalla-pde")]
     DirectUnavailable,
     /// The direct solver failed (singular system, e.g. `d` at an eigenvalue).
     #[error("direct solve failed: {0}")]

@@ -9,8 +9,8 @@
 //!   it replaced.
 //!
 //! ```sh
-//! CARGO_TARGET_DIR=... cargo bench -p unamalla-core --bench hex
-//! RAYON_NUM_THREADS=1 cargo bench -p unamalla-core --bench hex -- hessian   # one core
+//! CARGO_TARGET_DIR=... cargo bench -p unamalla-hex --bench hex
+//! RAYON_NUM_THREADS=1 cargo bench -p unamalla-hex --bench hex -- hessian   # one core
 //! ```
 // criterion_group! defines an undocumented `pub fn`; a bench has no public API to document.
 #![allow(missing_docs)]
@@ -19,10 +19,10 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
-use unamalla_core::functionals::{HexFunctional, HexTopology, Problem, Scaling3};
-use unamalla_core::hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
-use unamalla_core::mesh::StructuredGrid3;
-use unamalla_core::optim::NullObserver;
+use unamalla_functionals::{HexFunctional, HexTopology, Problem, Scaling3};
+use unamalla_hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
+use unamalla_mesh::StructuredGrid3;
+use unamalla_optim::NullObserver;
 
 fn sphere(nodes: usize) -> StructuredGrid3 {
     let case = HexCase::Sphere;

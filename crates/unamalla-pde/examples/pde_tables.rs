@@ -3,7 +3,7 @@
 //! regions (same manufactured problem, same node count, raw TFI vs optimized).
 //!
 //! ```text
-//! cargo run --release -p unamalla-core --features direct --example pde_tables [-- --quick]
+//! cargo run --release -p unamalla-pde --features direct --example pde_tables [-- --quick]
 //! ```
 //!
 //! `--quick` stops the convergence study at 81 × 81 nodes; `--payoff` prints only the payoff
@@ -11,13 +11,13 @@
 
 use std::time::Instant;
 
-use unamalla_core::io::{read_region_geojson_cleaned, PartSelector};
-use unamalla_core::mesh::quality::alpha_stats;
-use unamalla_core::mesh::{DVec2, HasNodes, Region, StructuredGrid2};
-use unamalla_core::optim::{smooth, NullObserver, SmoothOptions};
-use unamalla_core::pde::manufactured::{curved_grid, observed_order, Manufactured};
-use unamalla_core::pde::{solve_grid, Method, PdeError, Solution, SolveOptions};
 use unamalla_core::single_block::{tfi_region, Corners};
+use unamalla_io::{read_region_geojson_cleaned, PartSelector};
+use unamalla_mesh::quality::alpha_stats;
+use unamalla_mesh::{DVec2, HasNodes, Region, StructuredGrid2};
+use unamalla_optim::{smooth, NullObserver, SmoothOptions};
+use unamalla_pde::manufactured::{curved_grid, observed_order, Manufactured};
+use unamalla_pde::{solve_grid, Method, PdeError, Solution, SolveOptions};
 
 /// The two manufactured problems: (U, a, b, c, d).
 fn problems() -> [(Manufactured, [f64; 4]); 2] {

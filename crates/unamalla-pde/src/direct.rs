@@ -1,5 +1,5 @@
 //! The direct solver: sparse LU of the 9-point system over the interior unknowns
-//! (`faer`, cargo feature `direct`; module docs of [`crate::pde`] say why `faer`).
+//! (`faer`, cargo feature `direct`; crate docs of [`unamalla_pde`](crate) say why `faer`).
 
 use super::stencil::Row;
 use super::PdeError;

@@ -1,4 +1,4 @@
-//! SOR with the automatic relaxation factor (module docs of [`crate::pde`]).
+//! SOR with the automatic relaxation factor (crate docs of [`unamalla_pde`](crate)).
 
 use super::stencil::Row;
 use super::{PdeError, SolveOptions};

@@ -3,12 +3,12 @@
 //! `docs/benchmarks.md` / `docs/results.md` that is not a plain `unamalla hex` run comes from here.
 //!
 //! ```sh
-//! cargo run --release -p unamalla-core --example hex_study -- a-time [case] [runs]
-//! cargo run --release -p unamalla-core --example hex_study -- a-variants [case]
-//! cargo run --release -p unamalla-core --example hex_study -- hessian [cells] [runs]
-//! cargo run --release -p unamalla-core --example hex_study -- b-study <case> <mu0> <mu_min> <iters> [m,n,p]
-//! cargo run --release -p unamalla-core --example hex_study -- b-trace <case> <m,n,p|-> <mu0> <factor> <iters> <bj|mg|jacobi|none> <cg_max> [mu_min]
-//! cargo run --release -p unamalla-core --example hex_study -- energy [case ...]
+//! cargo run --release -p unamalla-hex --example hex_study -- a-time [case] [runs]
+//! cargo run --release -p unamalla-hex --example hex_study -- a-variants [case]
+//! cargo run --release -p unamalla-hex --example hex_study -- hessian [cells] [runs]
+//! cargo run --release -p unamalla-hex --example hex_study -- b-study <case> <mu0> <mu_min> <iters> [m,n,p]
+//! cargo run --release -p unamalla-hex --example hex_study -- b-trace <case> <m,n,p|-> <mu0> <factor> <iters> <bj|mg|jacobi|none> <cg_max> [mu_min]
+//! cargo run --release -p unamalla-hex --example hex_study -- energy [case ...]
 //! ```
 //!
 //! * `a-time`: best-of-`runs` wall time of Algorithm A alone (the `run_hex` driver with the
@@ -27,7 +27,7 @@
 //! * `energy`: the thesis's energy values (Cortés Aguirre 2012 §3.4.2–§3.4.3): per case,
 //!   `H_ω` of the perturbed start at the thesis's absolute `ω = 200` (parametric and index
 //!   scaling; the thesis's sphere starts at `f = 0.0261538`), then Algorithm A (defaults) and
-//!   the final mesh's [`energy_variants`](unamalla_core::functionals::energy_variants)
+//!   the final mesh's [`energy_variants`](unamalla_functionals::energy_variants)
 //!   (the thesis's sphere ends at `f = 2.26543`); for the sphere also the same with a
 //!   different cube → ball map (Nowell's, see `nowell_ball`) to show how much the radial map
 //!   itself moves the optimum.
@@ -38,11 +38,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use unamalla_core::functionals::{Csr, HexFunctional, HexTopology, LocalModel, Problem, Scaling3};
-use unamalla_core::hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
-use unamalla_core::optim::monitor::Session;
-use unamalla_core::optim::solver::minimize_with;
-use unamalla_core::optim::{NullObserver, Phase, SolverOptions};
+use unamalla_functionals::{Csr, HexFunctional, HexTopology, LocalModel, Problem, Scaling3};
+use unamalla_hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
+use unamalla_optim::monitor::Session;
+use unamalla_optim::solver::minimize_with;
+use unamalla_optim::{NullObserver, Phase, SolverOptions};
 
 /// User + system CPU seconds of this process (all threads), from `/proc/self/stat`
 /// (clock ticks of 10 ms); NaN where unavailable.
@@ -333,11 +333,9 @@ fn b_study(
     iters: usize,
     dims: Option<(usize, usize, usize)>,
 ) {
-    use unamalla_core::functionals::{
-        face_coplanarity_cos, face_planarity_max_cos, HEX_QUAD_FACES,
-    };
-    use unamalla_core::mesh::hexgen::{classify_cells, CellClass};
-    use unamalla_core::mesh::HasHexCells;
+    use unamalla_functionals::{face_coplanarity_cos, face_planarity_max_cos, HEX_QUAD_FACES};
+    use unamalla_mesh::hexgen::{classify_cells, CellClass};
+    use unamalla_mesh::HasHexCells;
     let dims = dims.unwrap_or_else(|| case.default_size());
     let mut g = case.initial_grid(dims).expect("grid");
     case.default_perturbation(dims)
@@ -419,7 +417,7 @@ struct BTrace {
     mu0: f64,
     factor: f64,
     iters: usize,
-    pre: unamalla_core::optim::Preconditioner,
+    pre: unamalla_optim::Preconditioner,
     cg_max: usize,
     mu_min: f64,
 }
@@ -517,9 +515,9 @@ fn b_trace(case: HexCase, dims: Option<(usize, usize, usize)>, o: &BTrace) {
 
 /// Nowell's cube → ball map `x·√(1 − y²/2 − z²/2 + y²z²/3)` (and cyclic), a smooth
 /// alternative to the radial map with a different boundary node distribution.
-fn nowell_ball(q: unamalla_core::mesh::DVec3) -> unamalla_core::mesh::DVec3 {
+fn nowell_ball(q: unamalla_mesh::DVec3) -> unamalla_mesh::DVec3 {
     let (x2, y2, z2) = (q.x * q.x, q.y * q.y, q.z * q.z);
-    unamalla_core::mesh::DVec3::new(
+    unamalla_mesh::DVec3::new(
         q.x * (1.0 - y2 / 2.0 - z2 / 2.0 + y2 * z2 / 3.0).sqrt(),
         q.y * (1.0 - z2 / 2.0 - x2 / 2.0 + x2 * z2 / 3.0).sqrt(),
         q.z * (1.0 - x2 / 2.0 - y2 / 2.0 + x2 * y2 / 3.0).sqrt(),
@@ -527,8 +525,8 @@ fn nowell_ball(q: unamalla_core::mesh::DVec3) -> unamalla_core::mesh::DVec3 {
 }
 
 fn energy(name: &str) {
-    use unamalla_core::functionals::energy_variants;
-    use unamalla_core::mesh::{HasHexCells, StructuredGrid3};
+    use unamalla_functionals::energy_variants;
+    use unamalla_mesh::{HasHexCells, StructuredGrid3};
     let (case, nowell) = match name {
         "sphere-nowell" => (HexCase::Sphere, true),
         n => (n.parse::<HexCase>().expect("case"), false),
@@ -537,7 +535,7 @@ fn energy(name: &str) {
     let mut g = if nowell {
         let t = |i: usize, k: usize| -1.0 + 2.0 * i as f64 / (k - 1) as f64;
         StructuredGrid3::from_fn(dims.0, dims.1, dims.2, |i, j, k| {
-            nowell_ball(unamalla_core::mesh::DVec3::new(
+            nowell_ball(unamalla_mesh::DVec3::new(
                 t(i, dims.0),
                 t(j, dims.1),
                 t(k, dims.2),
@@ -547,7 +545,7 @@ fn energy(name: &str) {
     } else {
         case.initial_grid(dims).expect("grid")
     };
-    let cells = |g: &StructuredGrid3| -> Vec<[unamalla_core::mesh::DVec3; 8]> {
+    let cells = |g: &StructuredGrid3| -> Vec<[unamalla_mesh::DVec3; 8]> {
         (0..g.num_hexes()).map(|c| g.hex_points(c)).collect()
     };
     let par = Scaling3::Parametric {
@@ -582,7 +580,7 @@ fn energy(name: &str) {
                 it: usize,
                 f: f64,
                 omega: f64,
-                e: &unamalla_core::functionals::EnergyVariants| {
+                e: &unamalla_functionals::EnergyVariants| {
         println!(
             "  {what} ({it} it): f {f:.5} at ω {omega:.3e}; E printed {:.5}, per-decomposition {:.5}, volume-weighted {:.5}, interior-raw {:.5} (V ≤ 0: {})",
             e.printed, e.per_decomposition, e.volume_weighted, e.interior_raw, e.non_positive
@@ -613,7 +611,7 @@ fn energy(name: &str) {
     };
     let rr = minimize_with(&hf, &mut x, &solver, &mut session, None).expect("minimize");
     let mut g2 = g.clone();
-    topo.scatter(&x, unamalla_core::mesh::HasNodes::nodes_mut(&mut g2));
+    topo.scatter(&x, unamalla_mesh::HasNodes::nodes_mut(&mut g2));
     let e2 = energy_variants(&cells(&g2), par).expect("energy");
     show("then H at ω = 1e-8·v̄", rr.iterations, rr.f, w, &e2);
 }
@@ -657,7 +655,7 @@ fn main() {
                 let v: Vec<usize> = s.split(',').map(|t| t.parse().expect("size")).collect();
                 (v[0], v[1], v[2])
             });
-            use unamalla_core::optim::Preconditioner as Pc;
+            use unamalla_optim::Preconditioner as Pc;
             let pre = match args.get(6).map(String::as_str).unwrap_or("bj") {
                 "mg" => Pc::Multigrid,
                 "jacobi" => Pc::Jacobi,

@@ -9,8 +9,8 @@
 //! * [`Manufactured::polynomial`]: the cubic
 //!   `U = 1 + 2x − 3y + x² − 2xy + 1.5y² + 0.5x³ − x²y + 0.7xy² − 0.4y³` (every monomial of
 //!   degree ≤ 3 present), `U_xx = 2 + 3x − 2y`, `U_xy = −2 − 2x + 1.4y`,
-//!   `U_yy = 3 + 1.4x − 2.4y`. The scheme is exact for it on affine grids (module docs of
-//!   [`crate::pde`]), so on curved grids the whole error is the metric's.
+//!   `U_yy = 3 + 1.4x − 2.4y`. The scheme is exact for it on affine grids (crate docs of
+//!   [`unamalla_pde`](crate)), so on curved grids the whole error is the metric's.
 
 use std::sync::Arc;
 

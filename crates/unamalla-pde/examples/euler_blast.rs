@@ -1,10 +1,10 @@
 //! The application of Cortés Aguirre (2012, chapter 5) with the first-order Euler solver of
-//! `unamalla_core::pde::euler`: a pressure blast in a closed ball (§5.1) or ellipsoid (§5.2)
+//! `unamalla_pde::euler`: a pressure blast in a closed ball (§5.1) or ellipsoid (§5.2)
 //! meshed by the hexahedral product's radial grid, written as a `.vtu` of hexahedra with the
 //! cell pressure and density.
 //!
 //! ```text
-//! cargo run --release -p unamalla-core --example euler_blast -- [sphere|ellipsoid] [N] [T] [OUT.vtu]
+//! cargo run --release -p unamalla-pde --example euler_blast -- [sphere|ellipsoid] [N] [T] [OUT.vtu]
 //! ```
 //!
 //! * `sphere` (default): the unit ball, p = 5 inside radius 0.2 about (0, 0, −0.4);
@@ -19,9 +19,9 @@
 
 use std::time::Instant;
 
-use unamalla_core::mesh::hexgen::ellipsoid_grid;
-use unamalla_core::mesh::DVec3;
-use unamalla_core::pde::euler::{primitive, EulerOptions, EulerSolver};
+use unamalla_mesh::hexgen::ellipsoid_grid;
+use unamalla_mesh::DVec3;
+use unamalla_pde::euler::{primitive, EulerOptions, EulerSolver};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -68,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let p = solver.pressure(opts.gamma, &q);
     let rho: Vec<f64> = q.iter().map(|s| primitive(opts.gamma, s).0).collect();
-    unamalla_core::io::write_vtu_hexes(
+    unamalla_io::write_vtu_hexes(
         &out,
         &grid,
         &[("pressure", p.as_slice()), ("density", rho.as_slice())],

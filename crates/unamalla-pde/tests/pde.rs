@@ -1,11 +1,11 @@
-//! Convergence of the curvilinear PDE solver (`unamalla_core::pde`) with manufactured
+//! Convergence of the curvilinear PDE solver (`unamalla_pde`) with manufactured
 //! solutions on a curved region: the nodal max error must shrink at second order when the
 //! grid spacing is halved, on TFI grids and on optimized grids.
 
-use unamalla_core::mesh::{HasNodes, StructuredGrid2};
-use unamalla_core::optim::{smooth, NullObserver, SmoothOptions};
-use unamalla_core::pde::manufactured::{curved_grid, observed_order, Manufactured};
-use unamalla_core::pde::{solve_grid, SolveOptions};
+use unamalla_mesh::{HasNodes, StructuredGrid2};
+use unamalla_optim::{smooth, NullObserver, SmoothOptions};
+use unamalla_pde::manufactured::{curved_grid, observed_order, Manufactured};
+use unamalla_pde::{solve_grid, SolveOptions};
 
 /// (U, [a, b, c, d]): the Laplacian with U = sin(πx)cosh(y), and a cubic with all four
 /// coefficients non-zero (a·c − b² = 1.75 > 0).

@@ -1,5 +1,5 @@
 //! The 9-node logical neighbourhoods and the transformed 9-point stencil (formulas in the
-//! module docs of [`crate::pde`]).
+//! crate docs of [`unamalla_pde`](crate)).
 //!
 //! Patch slot `k = 3·(δj + 1) + (δi + 1)` holds the node at logical offset `(δi, δj)`:
 //!
@@ -136,7 +136,7 @@ pub(crate) fn quad_patches<M: HasQuadCells + ?Sized>(
     Ok(out)
 }
 
-/// Assembles the rows (module docs of [`crate::pde`]). The equation is multiplied by −1 when
+/// Assembles the rows (crate docs of [`unamalla_pde`](crate)). The equation is multiplied by −1 when
 /// `a < 0` so that the diagonal is negative and the weights have one sign convention; the
 /// solution is unchanged.
 pub(crate) fn assemble(

@@ -1,10 +1,10 @@
-//! The Euler finite-volume solver (`unamalla_core::pde::euler`, the application of Cortés
+//! The Euler finite-volume solver (`unamalla_pde::euler`, the application of Cortés
 //! Aguirre 2012, chapter 5): Sod's shock tube against the exact Riemann solution, and the
 //! source's blast in a closed ball — conservation, positivity and the mesh's mirror symmetry.
 
-use unamalla_core::mesh::hexgen::ellipsoid_grid;
-use unamalla_core::mesh::{DVec3, StructuredGrid3};
-use unamalla_core::pde::euler::{primitive, EulerOptions, EulerSolver};
+use unamalla_mesh::hexgen::ellipsoid_grid;
+use unamalla_mesh::{DVec3, StructuredGrid3};
+use unamalla_pde::euler::{primitive, EulerOptions, EulerSolver};
 
 const GAMMA: f64 = 1.4;
 
