@@ -18,11 +18,11 @@
 //! the process CPU time (user + system, all threads) from `/proc/self/stat`.
 //!
 //! Tolerance (the same for every size, so the scaling is comparable): the run stops when the
-//! relative decrease of F in a step is at most FTOL (default 1e-9; `(F_old − F) ≤ FTOL·F`;
-//! near the optimum Newton's decrease approximates `F_old − F*`); GTOL is off unless given;
-//! MAXITER 500. The coarse levels of coarse-to-fine stop at FTOL 1e-6. The issue #4 scaling
-//! table in `docs/benchmarks.md` uses FTOL 1e-6 on every level (`… exact 1e-6 0`): on 301² it
-//! gives F within 2·10⁻⁶ (relative) of the FTOL-1e-9 result.
+//! relative decrease of F in a step is at most FTOL (default 1e-9; `(F_old − F) ≤ FTOL·F`; near the
+//! optimum Newton's decrease approximates `F_old − F*`); GTOL is off unless given; MAXITER 500. The
+//! coarse levels of coarse-to-fine stop at FTOL 1e-6. The scaling table of `docs/benchmarks.md`
+//! ("Large grids") uses FTOL 1e-6 on every level (`… exact 1e-6 0`): on 301² it gives F within
+//! 2·10⁻⁶ (relative) of the FTOL-1e-9 result.
 
 use std::time::Instant;
 

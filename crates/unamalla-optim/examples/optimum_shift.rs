@@ -1,13 +1,13 @@
 //! How far the ε-convex optimum of (6.8) moves when the grid is refined: the optimum on the
 //! coarse grid `(N − 1)/3 + 1`, prolongated to `N` ([`prolongate`]: the coarse-to-fine start),
-//! against the optimum on `N`, for several σ. Issue #4 evidence (docs/benchmarks.md, "Why
-//! 1000² in 5 s is out of reach at σ = 0.1").
+//! against the optimum on `N`, for several σ. The evidence of docs/benchmarks.md, "Why 1000² in
+//! 5 s is out of reach at σ = 0.1".
 //!
-//! `cargo run --release -p unamalla-optim --example optimum_shift -- [N] [SIGMAS]`
-//! (defaults `301` and `1,0.5,0.1`). Both optima: coarse-to-fine truncated Newton (multigrid
-//! preconditioner, FTOL 1e-6 on every level, the issue #4 rule). The shift of node `(i, j)`
-//! is measured in units of `h = √(mean cell area)` of the fine grid and summarized by the
-//! node's layer `min(i, j, N−1−i, N−1−j)` (distance to the boundary in cells).
+//! `cargo run --release -p unamalla-optim --example optimum_shift -- [N] [SIGMAS]` (defaults `301`
+//! and `1,0.5,0.1`). Both optima: coarse-to-fine truncated Newton (multigrid preconditioner, FTOL
+//! 1e-6 on every level, the rule of docs/benchmarks.md, "Large grids"). The shift of node `(i, j)`
+//! is measured in units of `h = √(mean cell area)` of the fine grid and summarized by the node's
+//! layer `min(i, j, N−1−i, N−1−j)` (distance to the boundary in cells).
 
 use unamalla_mesh::region::signed_area;
 use unamalla_mesh::{HasNodes, HasQuadCells, StructuredGrid2};

@@ -1,17 +1,17 @@
 //! Continuation drivers and the high-level `smooth` entry points.
 //!
-//! * [`adaptive_k`]: seed 001 Algorithms 4.1/4.2 with the practical update of §4.6.1
-//!   (`k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01`, a few iterations per `k`), the C²
-//!   continuation below `α̂ = −k + 0.015(α₋ + k)` (erratum 6), the double homotopy
-//!   `σ̂(k) = (1−σ)(k₀ − k)/(k₀ − k*ᾱ)` (5.20), optional Length pre-smoothing, then the classic
-//!   phase on `σ·f₁(k*) + (1−σ)·f₂`.
-//! * [`omega_continuation`] / [`omega_continuation_hex`]: seed 004 §3.4 Algorithm A — minimize
-//!   `H_ω`, halve `ω` until the mesh is ε-convex (floor `10⁻⁸`, relative to the mean measure),
-//!   then one refinement run.
-//! * [`coplanarity_continuation`]: seed 004 §4.2 Algorithm B — `H_ω + C·Σk²`, `C = 1/(2μ)`,
-//!   `μ₀ = 0.1`, `μ ← 0.1μ` while `μ > 10⁻¹²`.
-//! * [`block_smoothing`]: seed 000 (6.8)/(6.9) `F = (1−σ)·w·F_AO + σ·H_ω` (each normalized to
-//!   1 on the ideal grid) from an ε-convex start, with the safeguard at `ε·ᾱ`, so the result is
+//! * [`adaptive_k`]: [González Flores, Algorithm 4.1, Algorithm 4.2] with the practical update of
+//!   §4.6.1 (`k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01`, a few iterations per `k`), the C²
+//!   continuation below `α̂ = −k + 0.015(α₋ + k)` (not the printed (4.42), see
+//!   [`recommended_alpha_hat`]), the double homotopy `σ̂(k) = (1−σ)(k₀ − k)/(k₀ − k*ᾱ)` (5.20),
+//!   optional Length pre-smoothing, then the classic phase on `σ·f₁(k*) + (1−σ)·f₂`.
+//! * [`omega_continuation`] / [`omega_continuation_hex`]: [Cortés Aguirre 2012, §3.4, Algorithm A]
+//!   — minimize `H_ω`, halve `ω` until the mesh is ε-convex (floor `10⁻⁸`, relative to the mean
+//!   measure), then one refinement run.
+//! * [`coplanarity_continuation`]: [Cortés Aguirre 2012, §4.2, Algorithm B] — `H_ω + C·Σk²`,
+//!   `C = 1/(2μ)`, `μ₀ = 0.1`, `μ ← 0.1μ` while `μ > 10⁻¹²`.
+//! * [`block_smoothing`]: [Méndez 2023, (6.8), (6.9)] `F = (1−σ)·w·F_AO + σ·H_ω` (each normalized
+//!   to 1 on the ideal grid) from an ε-convex start, with the safeguard at `ε·ᾱ`, so the result is
 //!   ε-convex; a non-ε-convex start is first untangled by [`adaptive_k`].
 //!
 //! Contract: every driver keeps a convex start convex (the [`Session`] safeguard), and reports
@@ -38,7 +38,7 @@ use crate::solver::{
 use crate::status::{Status, StopReason};
 use unamalla_functionals::quad::psd::PsdProjection;
 
-/// The adaptive functional `f₁` and its partner `f₂` (seed 001 Tables 5.1/5.2, §7.3).
+/// The adaptive functional `f₁` and its partner `f₂` ([González Flores, Table 5.2, §A.4.3]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum KFunctional {
     /// `kSmooth-Area`: k-Smoothness with Area.
@@ -52,11 +52,11 @@ pub enum KFunctional {
     KArea,
 }
 
-/// The path `σ̃(t)` of the homotopy between functionals (González Flores, UNAMALLA thesis,
-/// §5.3, eqs. (5.14)–(5.18)): `f̃_c = (1 − σ̃)f₁ + σ̃f_c`, `σ̃` C¹ and increasing on `[0, 1]`
-/// with `σ̃(0) = 0`, `σ̃(1) = 1`. In the double homotopy of §5.4 the parameter is tied to the
-/// adaptive `k`, `t = (k₀ − k)/(k₀ − k*)` ((5.20) is the linear path), so the weight of the
-/// classic functional `f₂` is `σ̂ = (1 − σ)·σ̃(t)` (5.19) ([`homotopy_weight`]).
+/// The path `σ̃(t)` of the homotopy between functionals ([González Flores, §5.3, (5.14)–(5.18)]):
+/// `f̃_c = (1 − σ̃)f₁ + σ̃f_c`, `σ̃` C¹ and increasing on `[0, 1]` with `σ̃(0) = 0`, `σ̃(1) = 1`.
+/// In the double homotopy of §5.4 the parameter is tied to the adaptive `k`,
+/// `t = (k₀ − k)/(k₀ − k*)` ((5.20) is the linear path), so the weight of the classic functional
+/// `f₂` is `σ̂ = (1 − σ)·σ̃(t)` (5.19) ([`homotopy_weight`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum HomotopySchedule {
     /// `σ̃(t) = t`: the linear homotopy (5.20), UNAMALLA's practical scheme.
@@ -119,8 +119,8 @@ impl FromStr for HomotopySchedule {
     }
 }
 
-/// The weight `σ̂` of the classic functional `f₂` in the double homotopy (González Flores,
-/// UNAMALLA thesis, §5.3–§5.4, (5.19)–(5.20)): `σ̂ = w_final·σ̃(t)` with
+/// The weight `σ̂` of the classic functional `f₂` in the double homotopy
+/// ([González Flores, §5.3–§5.4, (5.19)–(5.20)]): `σ̂ = w_final·σ̃(t)` with
 /// `t = (k₀ − k)/(k₀ − k*)` clamped to `[0, 1]` and `w_final = 1 − σ` (σ = weight of the adaptive
 /// `f₁`). If `k` rises again, `t` and `σ̂` fall back with it (the automatic restart of Fig 5.8).
 /// With `k₀ ≤ k*` (the start is already at the floor) the target weight is returned.
@@ -163,8 +163,8 @@ pub struct AdaptiveKOptions {
     #[serde(default)]
     pub schedule: HomotopySchedule,
     /// End the homotopy once the mesh is convex with `α₋ > −k*·ᾱ` — the triangle-area
-    /// bound that the floor `k*` stands for (González Flores, UNAMALLA thesis, §4.3: the
-    /// sequence can be continued past convexity "to a target k*" to obtain `α > −k*`).
+    /// bound that the floor `k*` stands for ([González Flores, Algorithm 4.1]: the sequence can
+    /// be continued past convexity "to a target k*" to obtain `α > −k*`).
     ///
     /// `false` (the thesis's loop, the default): the homotopy ends when the practical update
     /// `k̃ = −1.0015·α₋ + 0.01·ᾱ` (4.35) has reached the floor, i.e. only once
@@ -199,13 +199,13 @@ impl Default for AdaptiveKOptions {
 pub struct OmegaOptions {
     /// `ω₀` in units of the mean measure (`ᾱ` or the mean tetrahedron Jacobian).
     pub omega0_rel: f64,
-    /// Floor of `ω`, relative (seed 004: `ω* = 10⁻⁸`).
+    /// Floor of `ω`, relative ([Cortés Aguirre 2012, Algorithm A]: `ω* = 10⁻⁸`).
     pub omega_floor_rel: f64,
     /// ε of ε-convexity (`α₋ > ε·ᾱ`).
     pub eps: f64,
     /// Run the refinement step after ε-convexity is reached.
     pub refinement: bool,
-    /// Solver options of each minimization (seed 004: tolerances 10⁻⁴).
+    /// Solver options of each minimization ([Cortés Aguirre 2012, §3.4]: tolerances 10⁻⁴).
     pub solver: SolverOptions,
 }
 
@@ -229,7 +229,7 @@ impl Default for OmegaOptions {
 /// Options of Algorithm B ([`coplanarity_continuation`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoplanarityOptions {
-    /// Fixed `ω` relative to the mean Jacobian (seed 004: `10⁻⁸`).
+    /// Fixed `ω` relative to the mean Jacobian ([Cortés Aguirre 2012, Algorithm B]: `10⁻⁸`).
     pub omega_rel: f64,
     /// `μ₀` (default 500, the thesis's Table 4.5 alternative; the thesis's default is 0.1,
     /// see [`CoplanarityOptions::thesis`]).
@@ -250,8 +250,8 @@ pub struct CoplanarityOptions {
 }
 
 impl CoplanarityOptions {
-    /// The thesis's schedule (seed 004 §4.2, App. B defaults): `μ₀ = 0.1`, `μ ← 0.1μ` while
-    /// `μ > 10⁻¹²`, no planarity stop.
+    /// The thesis's schedule ([Cortés Aguirre 2012, §4.2, App. B] defaults): `μ₀ = 0.1`, `μ ← 0.1μ`
+    /// while `μ > 10⁻¹²`, no planarity stop.
     pub fn thesis() -> Self {
         Self {
             mu0: 0.1,
@@ -501,7 +501,7 @@ fn check_sigma(name: &'static str, s: f64) -> Result<(), OptimError> {
     }
 }
 
-/// UNAMALLA's optional "Previous Smoothness" (González Flores, UNAMALLA thesis, §A.4.3):
+/// UNAMALLA's optional "Previous Smoothness" ([González Flores, §A.4.3]):
 /// `iters` iterations of normalized Length with truncated Newton + line search. Returns the
 /// functional and the solver result if the run was interrupted (stop, time limit), `None`
 /// otherwise (also for `iters = 0`).
@@ -569,9 +569,9 @@ fn on_plateau(values: &[f64]) -> bool {
     }
 }
 
-/// Seed 001 Algorithms 4.1/4.2 as implemented in UNAMALLA 2.0 (§4.6.1, §5.4): adaptive `k`
-/// with the double homotopy, then the classic phase. `x` (free-node coordinates of `topo`) is
-/// overwritten with the result.
+/// [González Flores, Algorithm 4.1, Algorithm 4.2] as implemented in UNAMALLA 2.0 (§4.6.1, §5.4):
+/// adaptive `k` with the double homotopy, then the classic phase. `x` (free-node coordinates of
+/// `topo`) is overwritten with the result.
 pub fn adaptive_k(
     topo: &Arc<QuadTopology>,
     x: &mut [f64],
@@ -706,8 +706,8 @@ pub fn adaptive_k(
     Ok(rep)
 }
 
-/// Seed 004 §3.4 Algorithm A on a quad mesh: minimize `H_ω` (normalized), halve `ω` until
-/// `α₋ > ε·ᾱ` or `ω` reaches the floor, then one refinement run (safeguarded at `ε·ᾱ`).
+/// [Cortés Aguirre 2012, §3.4, Algorithm A] on a quad mesh: minimize `H_ω` (normalized), halve `ω`
+/// until `α₋ > ε·ᾱ` or `ω` reaches the floor, then one refinement run (safeguarded at `ε·ᾱ`).
 pub fn omega_continuation(
     topo: &Arc<QuadTopology>,
     x: &mut [f64],
@@ -809,8 +809,8 @@ fn omega_loop<P: Problem>(
     Ok(rep)
 }
 
-/// Seed 004 §3.4 Algorithm A on a hexahedral mesh (`H_ω` over the 10 tetrahedra of each
-/// hexahedron, ε-convexity `V > ε·v̄`).
+/// [Cortés Aguirre 2012, §3.4, Algorithm A] on a hexahedral mesh (`H_ω` over the 10 tetrahedra of
+/// each hexahedron, ε-convexity `V > ε·v̄`).
 pub fn omega_continuation_hex(
     topo: &Arc<HexTopology>,
     scaling: Scaling3,
@@ -841,10 +841,11 @@ pub fn omega_continuation_hex(
     )
 }
 
-/// Seed 004 §4.2 Algorithm B: from a convex (Algorithm A) mesh, minimize `H_ω + C·Σk²` with
-/// `C = 1/(2μ)` for `μ = μ₀, 0.1μ₀, …` while `μ > μ_min`; the safeguard keeps the mesh convex.
+/// [Cortés Aguirre 2012, §4.2, Algorithm B]: from a convex (Algorithm A) mesh, minimize
+/// `H_ω + C·Σk²` with `C = 1/(2μ)` for `μ = μ₀, 0.1μ₀, …` while `μ > μ_min`; the safeguard keeps
+/// the mesh convex.
 ///
-/// # Default schedule (issue #10; measured in `docs/results.md`, "Algorithm B")
+/// # Default schedule (measured in `docs/results.md`, "Algorithm B")
 /// * **μ₀ = 500** (`C₀ = 10⁻³`), the thesis's Table 4.5 alternative, instead of its default
 ///   0.1 (`C₀ = 5`). `H_ω` carries the thesis's `1/(10N_c)` normalization (of order 1) while
 ///   `Σk²` runs over all `6·N_int` interior faces, so `C₀ = 5` makes the penalty dominate
@@ -1020,7 +1021,7 @@ impl Default for BlockSmoothingOptions {
     }
 }
 
-/// Seed 000 (6.8)/(6.9): `F = (1−σ)·w·F_AO + σ·H_ω` with the ε-convexity guarantee (see the
+/// [Méndez 2023, (6.8), (6.9)]: `F = (1−σ)·w·F_AO + σ·H_ω` with the ε-convexity guarantee (see the
 /// module docs). `x` is overwritten.
 pub fn block_smoothing(
     topo: &Arc<QuadTopology>,
@@ -1128,10 +1129,9 @@ pub fn block_smoothing(
     Ok(rep)
 }
 
-/// The classic combinations of González Flores, UNAMALLA thesis, §5.2 Table 5.1 and App. A
-/// §A.4.3 (the `Area-Lenght` and `Area-Ortho.` entries of the Functional menu), each the convex
-/// combination `σ·F̃₁ + (1 − σ)·F̃₂` of normalized functionals (§5.1; σ is the weight of the
-/// first-named functional, (5.1)–(5.2)).
+/// The classic combinations of [González Flores, Table 5.1, §A.4.3] (the `Area-Lenght` and
+/// `Area-Ortho.` entries of the Functional menu), each the convex combination `σ·F̃₁ + (1 − σ)·F̃₂`
+/// of normalized functionals (§5.1; σ is the weight of the first-named functional, (5.1)–(5.2)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum ClassicCombination {
     /// t-Area – Length: `σ·Σα²/(Nᾱ²) + (1 − σ)·Σl/(2Nᾱ)` (Table 5.1 weights .95, .7, .5; the
@@ -1193,7 +1193,7 @@ pub struct ClassicOptions {
 /// Minimizes a classic combination ([`ClassicCombination`]) from `x` with the safeguard (a
 /// convex start stays convex). Unlike the adaptive functionals these do not untangle: the
 /// thesis reports none of its four test regions convex with t-Area–Length at σ = .5 or .95
-/// (§5.2, Figs 5.2–5.3); a folded start is minimized without the safeguard and the report says
+/// (Figs 5.2–5.3); a folded start is minimized without the safeguard and the report says
 /// whether it came out convex.
 pub fn classic_combination(
     topo: &Arc<QuadTopology>,
@@ -1219,14 +1219,13 @@ pub fn classic_combination(
     Ok(report(session, &p, x, &init, messages, Some(r), opts.eps))
 }
 
-/// Untangles with Ivanenko's convex-mesh functional `Σ((ε_I − α)₊)²` (González Flores,
-/// UNAMALLA thesis, §2.2 eq. (2.50), after Ivanenko), scaled by `1/(N·ε_I²)`: the value is 0
-/// exactly when every triangle has `α ≥ ε_I`. The minimization approaches that zero set from
-/// below and the stopping tests end it a hair short (measured on Ivanenko's folded 11 × 11
-/// grid with `ε_I = 0.01ᾱ`: `α₋ = 0.0099994ᾱ`), so the functional is given `ε_I = 2·eps·ᾱ` and
-/// the report's ε-convexity is checked at `eps`. The functional only pushes small triangles
-/// up; it has no smoothing term (the thesis uses it for an initial convex mesh). A start that
-/// is already ε-convex is returned unchanged.
+/// Untangles with Ivanenko's convex-mesh functional `Σ((ε_I − α)₊)²` ([González Flores, (2.50)],
+/// after Ivanenko), scaled by `1/(N·ε_I²)`: the value is 0 exactly when every triangle has
+/// `α ≥ ε_I`. The minimization approaches that zero set from below and the stopping tests end it a
+/// hair short (measured on Ivanenko's folded 11 × 11 grid with `ε_I = 0.01ᾱ`: `α₋ = 0.0099994ᾱ`),
+/// so the functional is given `ε_I = 2·eps·ᾱ` and the report's ε-convexity is checked at `eps`. The
+/// functional only pushes small triangles up; it has no smoothing term (the thesis uses it for an
+/// initial convex mesh). A start that is already ε-convex is returned unchanged.
 pub fn ivanenko_untangle(
     topo: &Arc<QuadTopology>,
     x: &mut [f64],
@@ -1262,7 +1261,8 @@ pub fn ivanenko_untangle(
 /// The functional (and driver) of [`smooth`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum SmoothFunctional {
-    /// `ao-homega`: seed 000 (6.8)/(6.9) with the ε-convexity guarantee ([`block_smoothing`]).
+    /// `ao-homega`: [Méndez 2023, (6.8), (6.9)] with the ε-convexity guarantee
+    /// ([`block_smoothing`]).
     BlockSmoothing {
         /// σ (weight of `H_ω`).
         sigma: f64,
@@ -1306,7 +1306,7 @@ impl SmoothFunctional {
 }
 
 impl Default for SmoothFunctional {
-    /// (6.8) with σ = 0.1 (seed 000's Laguna Honda example).
+    /// (6.8) with σ = 0.1 (the Laguna Honda example of [Méndez 2023, Example 6.3]).
     fn default() -> Self {
         SmoothFunctional::block_smoothing(0.1)
     }
@@ -1548,8 +1548,8 @@ pub fn smooth<M: HasQuadCells + FreeNodes + ?Sized>(
 
 /// Smooths several independent meshes in parallel (rayon), each with [`smooth`] and its own
 /// fixed nodes — e.g. the blocks of a decomposition before they are merged, each with its
-/// boundary fixed (seed 000 digest §5.5: the blocks are smoothed one by one before the
-/// global smoothing of the merged mesh).
+/// boundary fixed ([Méndez 2023, §6.3]: the blocks are smoothed one by one before the global
+/// smoothing of the merged mesh).
 ///
 /// Meshes for which `select` returns `false` are left alone (their entry is `None`). Runs
 /// still going at `deadline` are stopped there (their status says "STOP by user"); as in
@@ -1598,7 +1598,8 @@ pub struct HexSmoothOptions {
     pub driver: HexDriver,
     /// Tetrahedron scaling of `H_ω`.
     pub scaling: Scaling3,
-    /// Algorithm A options (ε default 10⁻⁴ here, seed 004 Tables 3.1–3.2).
+    /// Algorithm A options (ε default 10⁻⁴ here, as for
+    /// [Cortés Aguirre 2012, Table 3.1, Table 3.2]).
     pub omega: OmegaOptions,
     /// Algorithm B options.
     pub coplanarity: CoplanarityOptions,

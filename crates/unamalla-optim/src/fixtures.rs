@@ -1,14 +1,15 @@
-//! The test regions of seed 001 digest §5 as folded TFI grids, and the curvy four-sided
-//! benchmark region.
+//! The test regions of [González Flores] (§A.4.3, §A.5, (2.3)–(2.6)) as folded TFI grids, and the
+//! curvy four-sided benchmark region.
 //!
-//! * [`cuad2pp`]: the contour of `cuad2pp.red` (§7.4): B1 = (0.4,0)–(0.6,0), B2 = (0.6,0)–(1,0),
+//! * [`cuad2pp`]: the contour of `cuad2pp.red` (§A.5): B1 = (0.4,0)–(0.6,0), B2 = (0.6,0)–(1,0),
 //!   B3 = (1,0),(1,1),(0,1),(0,0), B4 = (0,0)–(0.4,0). Two block corners, (0.4,0) and (0.6,0),
 //!   are straight angles, so their corner triangles (all three vertices fixed) have α = 0.
-//! * [`one_hole`]: the 13-point contour with `ibflag = 13`: B1 = cut (0,0)→(9,0), B2 = the
-//!   hexagonal hole (9,0),(12,4),(16,4),(19,1),(15,−3),(11,−3),(9,0) (clockwise), B3 = the cut
-//!   back, B4 = the outer quadrilateral (0,0),(20,−15),(30,1),(12,15),(0,0).
+//! * [`one_hole`]: the 13-point contour with `ibflag = 13` (§A.5.1, Fig A.40): B1 = cut
+//!   (0,0)→(9,0), B2 = the hexagonal hole (9,0),(12,4),(16,4),(19,1),(15,−3),(11,−3),(9,0)
+//!   (clockwise), B3 = the cut back, B4 = the outer quadrilateral
+//!   (0,0),(20,−15),(30,1),(12,15),(0,0).
 //! * [`ivanenko`]: the image of the unit square under `x = ½(ξ²−η²) − ⅔ξ`,
-//!   `y = ξη + ½ξ − ⅓η` (seed 001 (2.3)–(2.6)), boundary sampled uniformly in `ξ`, `η`.
+//!   `y = ξη + ½ξ − ⅓η` ((2.3)–(2.6)), boundary sampled uniformly in `ξ`, `η`.
 //! * [`sinusoidal`]: the unit square with sinusoidal sides (the benchmark region).
 //!
 //! Sides with polyline data are resampled by arc length; the interior is plain TFI

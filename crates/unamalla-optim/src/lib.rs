@@ -5,21 +5,22 @@
 //! Design follows `argmin`'s separation: a [`Problem`](unamalla_functionals::Problem)
 //! (value, gradient, sparse Hessian / Hessian-vector product, local models, element
 //! measures), a solver ([`solver`]), an observer ([`monitor`]) and the convexity safeguard
-//! ([`safeguard`]).
+//! ([`safeguard`]). Sources are cited as `[Key, §x]` or `[Key, (eq)]`; the keys are listed in
+//! `docs/references.md` of the repository.
 //!
-//! ## Solvers ([`solver`]; seed 001 digest §3 and App. B)
-//! * **Truncated Newton, trust region** ([`Solver::TnTr`], UNAMALLA's default; the TRON family
-//!   of seed 000 §5.5 and seed 004 §3.3): preconditioned Steihaug–Toint CG in the `M`-norm,
-//!   negative-curvature exit to the boundary, forcing sequence
+//! ## Solvers ([`solver`]; [González Flores, App. B])
+//! * **Truncated Newton, trust region** ([`Solver::TnTr`], UNAMALLA's default; the TRON family of
+//!   [Méndez 2023, §6.4.2] and [Cortés Aguirre 2012, §3.3]): preconditioned Steihaug–Toint CG in
+//!   the `M`-norm, negative-curvature exit to the boundary, forcing sequence
 //!   `η_k = min(η_max, √(‖g_k‖/‖g₀‖))`, radius update on `ρ = ared/pred`.
 //! * **Truncated Newton, line search** ([`Solver::TnLs`]): the same inner CG (negative
 //!   curvature: stop, or preconditioned steepest descent at the first inner iteration) and a
 //!   Moré–Thuente line search ([`linesearch`], a port of MINPACK-2 `dcsrch`).
 //! * **L-BFGS(m)** ([`Solver::Lbfgs`], two-loop recursion, `m` = 3 or 5 in UNAMALLA, any `m`).
-//! * **Nonlinear CG** ([`Solver::NcgFr`], Fletcher & Reeves 1964; the predecessor system's
-//!   third method, González Flores, thesis, Preface): `β = ‖g_{k+1}‖²/‖g_k‖²`, strong-Wolfe
+//! * **Nonlinear CG** ([`Solver::NcgFr`], [Fletcher & Reeves 1964]; the predecessor system's
+//!   third method, [González Flores, Preface]): `β = ‖g_{k+1}‖²/‖g_k‖²`, strong-Wolfe
 //!   Moré–Thuente line search with curvature constant ≤ 0.1, restart every `n` iterations.
-//! * **Pointwise Newton** ([`Solver::Pointwise`], García; seed 001 §B.5.2): Gauss–Seidel
+//! * **Pointwise Newton** ([`Solver::Pointwise`], García; [González Flores, §B.5.2]): Gauss–Seidel
 //!   sweeps over the free nodes, each solving the local 2×2 (3×3) Newton system
 //!   ("simultaneous") or one coordinate at a time ("by components"), with an Armijo test on
 //!   the local value. Nodes are coloured (no two nodes of a colour share a cell), so each
@@ -51,7 +52,7 @@
 //! vertices are all fixed are boundary data: they are excluded and counted separately.
 //!
 //! When the functional's optimum has cells *at* the threshold (the ε-convex smoothing of a
-//! region with very thin passages), two details matter (issue #8, gulf-of-mexico):
+//! region with very thin passages), two details matter (found on gulf-of-mexico):
 //! * the trust-region step is cut at the exact first crossing (α is quadratic along a 2D
 //!   step); if that shortens the step, the nodes of the blocking cells are **held back**
 //!   instead ([`Session::hold_back`]: their direction components
@@ -63,7 +64,7 @@
 //!   before, the guard switched off there and the run could fold cells again (the pipeline
 //!   then had to fall back to the start of the run). Test: `tests/guard.rs`.
 //!
-//! ## Stopping and status ([`status`]; seed 001 digest §7.3, Table A.2)
+//! ## Stopping and status ([`status`]; [González Flores, Table A.2])
 //! FTOL (relative decrease of F), GTOL (‖g‖ relative to the first gradient, or absolute),
 //! MAXITER, stop by the observer, line-search failures (xtol, rounding, STPMIN, STPMAX, FCN
 //! calls) and trust-radius collapse; beyond Table A.2, the window tests of [`StopRules`]
@@ -72,28 +73,30 @@
 //! ([`Session::set_time_limit`], "STOP by TIME LIMIT" —
 //! never a default: without it a run's result does not depend on the machine). [`Status`]'s `Display` prints the UNAMALLA messages.
 //!
-//! ## Observer ([`monitor`]; Table A.1)
+//! ## Observer ([`monitor`]; [González Flores, Table A.1])
 //! Every iteration the observer receives a [`Monitor`]: Alfamin (α₋), ᾱ,
 //! Kcurrent/Kold (k/ᾱ), ω, μ, Inocon, F, ‖g‖, IterSmooth/IterHomotopic/IterClassic, elapsed
 //! time; it may stop the run. [`ProgressObserver`] prints one
 //! updating line to stderr.
 //!
 //! ## Drivers ([`drivers`])
-//! * [`adaptive_k`](drivers::adaptive_k): seed 001 Algorithms 4.1/4.2 with the practical update
-//!   `k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01` (§2.5, (4.35)), a few iterations per `k`,
-//!   the C² continuation below `α̂` (erratum 6), the double homotopy `σ̂(k)` (5.20), optional
-//!   Length pre-smoothing, then the classic phase; the path of the double homotopy is
-//!   selectable ([`HomotopySchedule`]: linear (5.20), `t²`, `t³`, `sin(πt/2)`, González
-//!   Flores, UNAMALLA thesis, §5.3 (5.16)–(5.18)).
+//! * [`adaptive_k`](drivers::adaptive_k): [González Flores, Algorithm 4.1, Algorithm 4.2] with
+//!   the practical update `k = max(k*ᾱ, −1.0015α₋ + 0.01ᾱ)`, `k* = −0.01` (§4.6.1, (4.35)), a few
+//!   iterations per `k`, the C² continuation below `α̂` (§4.6.3, with the matching point of
+//!   [`recommended_alpha_hat`](unamalla_functionals::recommended_alpha_hat), not the printed
+//!   (4.42)), the double homotopy `σ̂(k)` (5.20), optional Length pre-smoothing, then the
+//!   classic phase; the path of the double homotopy is selectable ([`HomotopySchedule`]:
+//!   linear (5.20), `t²`, `t³`, `sin(πt/2)`, [González Flores, §5.3, (5.16)–(5.18)]).
 //! * [`classic_combination`]: the classic t-Area–Length and t-Area–Orthogonality
-//!   combinations of the same thesis (§5.2 Table 5.1), which do not untangle.
-//! * [`ivanenko_untangle`]: Ivanenko's convex-mesh functional `Σ((ε − α)₊)²` (same thesis,
-//!   §2.2 (2.50)).
+//!   combinations of the same thesis ([González Flores, Table 5.1]), which do not untangle.
+//! * [`ivanenko_untangle`]: Ivanenko's convex-mesh functional `Σ((ε − α)₊)²`
+//!   ([González Flores, (2.50)]).
 //! * [`omega_continuation`](drivers::omega_continuation) /
-//!   [`omega_continuation_hex`](drivers::omega_continuation_hex): seed 004 §3.4 Algorithm A.
-//! * [`coplanarity_continuation`](drivers::coplanarity_continuation): seed 004 §4.2
-//!   Algorithm B.
-//! * [`block_smoothing`](drivers::block_smoothing): seed 000 §5.5 (6.8)/(6.9) with the
+//!   [`omega_continuation_hex`](drivers::omega_continuation_hex):
+//!   [Cortés Aguirre 2012, §3.4, Algorithm A].
+//! * [`coplanarity_continuation`](drivers::coplanarity_continuation):
+//!   [Cortés Aguirre 2012, §4.2, Algorithm B].
+//! * [`block_smoothing`](drivers::block_smoothing): [Méndez 2023, §6.4.2, (6.8), (6.9)] with the
 //!   ε-convexity guarantee.
 //! * [`smooth`] / [`smooth_hex`]: the entry points used by `unamalla smooth`; they never return
 //!   more non-convex cells than they were given ([`SmoothReport::restored`]).
@@ -103,8 +106,8 @@
 //!   put back by a transfinite correction, repair), then finished on the fine grid.
 //!
 //! ## Fixtures ([`fixtures`])
-//! The seed 001 §5 test regions (`cuad2pp`, the one-hole contour, Ivanenko's region) as TFI
-//! grids, and the sinusoidal benchmark region.
+//! The test regions of [González Flores] (`cuad2pp`, the one-hole contour, Ivanenko's region) as
+//! TFI grids, and the sinusoidal benchmark region.
 
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 

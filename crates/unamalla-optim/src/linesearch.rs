@@ -1,12 +1,12 @@
 //! Moré–Thuente line search: a port of MINPACK-2 `dcsrch`/`dcstep` (Moré & Thuente 1994),
-//! the line search UNAMALLA 2.0 used (seed 001 digest §3, App. B), whose info codes are the
-//! line-search messages of Table A.2.
+//! the line search UNAMALLA 2.0 used ([González Flores, App. B]), whose info codes are the
+//! line-search messages of [González Flores, Table A.2].
 //!
-//! Written here rather than taken from `argmin` because (a) trial points outside the
-//! admissible set (the convexity safeguard) must be rejected by bisection toward the best
-//! point, which `argmin`'s `MoreThuente` cannot express, (b) it must never panic (argmin's
-//! panics with "not a descent direction", reference notes §5), and (c) its failure codes map
-//! one-to-one onto the UNAMALLA status messages.
+//! Written here rather than taken from `argmin` because (a) trial points outside the admissible set
+//! (the convexity safeguard) must be rejected by bisection toward the best point, which `argmin`'s
+//! `MoreThuente` cannot express, (b) it must never panic (older argmin releases panicked with "not
+//! a descent direction"; 0.11 returns an error), and (c) its failure codes map one-to-one onto the
+//! UNAMALLA status messages.
 
 use crate::status::LineSearchFailure;
 

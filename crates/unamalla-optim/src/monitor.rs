@@ -1,4 +1,4 @@
-//! The monitor (seed 001 digest §7.3, Table A.1), the observers and the quality probe of the
+//! The monitor ([González Flores, §A.4.3, Table A.1]), the observers and the quality probe of the
 //! plateau test. The per-run bookkeeping that measures convexity and enforces the domain
 //! safeguard ([`Session`], [`Convexity`]) is in [`crate::safeguard`] and re-exported here.
 
@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 pub use crate::safeguard::{Convexity, Session, GUARD_MARGIN};
 
 /// The phase a driver is in (the three iteration counters of Table A.1, plus the continuation
-/// phases of seed 004).
+/// phases of [Cortés Aguirre 2012, Algorithm A, Algorithm B]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum Phase {
     /// Pre-smoothing with Length ("IterSmooth").

@@ -2,13 +2,12 @@
 //! the inner CG of truncated Newton ([`Preconditioner::Multigrid`](crate::Preconditioner)).
 //!
 //! # Why
-//! The Hessians of the smoothing functionals ((6.8) of the seed 000 digest §5.5, the
-//! area/length/Winslow kernels of the seed 001 digest §2) are discrete second-order elliptic
-//! operators ("Laplacian-like"): their condition number grows like `h⁻²`, so CG preconditioned
-//! by the node-block diagonal needs `O(√κ) = O(n)` iterations on an `n × n` grid (measured:
-//! the 200-iteration cap is hit from 300² on; see `docs/benchmarks.md`). A multigrid V-cycle
-//! is a preconditioner whose quality does not depend on `h`, so CG needs a bounded number of
-//! iterations per Newton step.
+//! The Hessians of the smoothing functionals ([Méndez 2023, (6.8)], the area/length/Winslow kernels
+//! of [González Flores, Ch. 2–3]) are discrete second-order elliptic operators ("Laplacian-like"):
+//! their condition number grows like `h⁻²`, so CG preconditioned by the node-block diagonal needs
+//! `O(√κ) = O(n)` iterations on an `n × n` grid (measured: the 200-iteration cap is hit from 300²
+//! on; see `docs/benchmarks.md`). A multigrid V-cycle is a preconditioner whose quality does not
+//! depend on `h`, so CG needs a bounded number of iterations per Newton step.
 //!
 //! # Algorithm (Vaněk, Mandel, Brezina 1996, "Algebraic multigrid by smoothed aggregation")
 //! Unknowns are grouped by node (`dim` coordinates per node, interleaved as in the Hessians of

@@ -1,5 +1,5 @@
 //! [`PsdModel`]: a quad functional whose [`Problem::hessian`] is the PSD-projected model
-//! Hessian of `unamalla_functionals::quad::psd` (issue #4, [`HessianMode::ProjectedPsd`]).
+//! Hessian of `unamalla_functionals::quad::psd` ([`HessianMode::ProjectedPsd`]).
 //!
 //! Value and gradient are the functional's own (exact), so every solver still minimizes the
 //! same `F` and the stopping tests (FTOL, GTOL) mean the same; only the quadratic model of

@@ -1,6 +1,7 @@
 //! The solvers: truncated Newton with a trust region (Steihaug–CG) or a Moré–Thuente line
-//! search, L-BFGS(m), and pointwise (Gauss–Seidel) Newton (seed 001 digest §3 and App. B;
-//! seed 000 §5.5 and seed 004 §3.3 use TRON, a trust-region truncated Newton).
+//! search, L-BFGS(m), and pointwise (Gauss–Seidel) Newton ([González Flores, App. B]; the
+//! references are listed in `docs/references.md` of the repository; [Méndez 2023, §6.4.2] and
+//! [Cortés Aguirre 2012, §3.3] use TRON, a trust-region truncated Newton).
 //!
 //! All of them work on any [`Problem`] and report every iteration to a [`Session`], which
 //! also enforces the convexity safeguard: when the iterate is convex (every element with a
@@ -24,7 +25,8 @@ use crate::status::{LineSearchFailure, StopReason};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum Solver {
     /// `tn-tr`: truncated Newton with a trust region (Steihaug–CG, negative-curvature exit);
-    /// UNAMALLA's default and the TRON family of seeds 000/004.
+    /// UNAMALLA's default and the TRON family of [Méndez 2023, §6.4.2] and
+    /// [Cortés Aguirre 2012, §3.3].
     #[default]
     TnTr,
     /// `tn-ls`: truncated Newton with a Moré–Thuente line search.
@@ -34,7 +36,7 @@ pub enum Solver {
     /// `pointwise`: Gauss–Seidel sweeps of local 2×2 / 3×3 Newton steps (García).
     Pointwise,
     /// `ncg-fr`: nonlinear conjugate gradients of Fletcher & Reeves (1964), one of the methods
-    /// of UNAMALLA's predecessor (González Flores, thesis, Preface): `d₀ = −g₀`,
+    /// of UNAMALLA's predecessor ([González Flores, Preface]): `d₀ = −g₀`,
     /// `d_{k+1} = −g_{k+1} + β_k d_k`, `β_k = ‖g_{k+1}‖²/‖g_k‖²`, with a strong-Wolfe line search
     /// of curvature constant at most 0.1 (below ½, so every `d_k` is a descent direction:
     /// Al-Baali 1985) and a restart `d = −g` every `n` iterations or when `d` is not a descent
@@ -95,8 +97,7 @@ pub enum PointwiseMode {
 
 impl PointwiseMode {
     /// The command-line name (`simultaneous`, `components`; UNAMALLA's "simultaneous" and
-    /// "by components" modes of Newton Point to Point, González Flores, UNAMALLA thesis,
-    /// §A.4.3 and App. B §B.5.2).
+    /// "by components" modes of Newton Point to Point, [González Flores, §A.4.3, §B.5.2]).
     pub fn name(self) -> &'static str {
         match self {
             PointwiseMode::Simultaneous => "simultaneous",
@@ -134,7 +135,7 @@ pub enum HessianMode {
     /// onto the PSD cone before assembly (`unamalla_functionals::quad::psd`), a Gauss–Newton-like
     /// model whose CG never meets negative curvature. For any other [`Problem`] this is
     /// `Assembled` (the solver asks the problem for its Hessian). Used by `block_smoothing`
-    /// ((6.8)) only. Measured (docs/benchmarks.md, issue #4): 8–14× slower than the exact
+    /// ((6.8)) only. Measured (docs/benchmarks.md, "Large grids"): 8–14× slower than the exact
     /// Hessian on the sinusoidal 100² grid, because `F_AO`'s leg Hessian is indefinite for
     /// every triangle, so the model differs from the Hessian even at the minimum.
     ProjectedPsd,
@@ -187,7 +188,8 @@ pub struct SolverOptions {
 /// * **quality plateau** ([`StopReason::Plateau`]): over the last `W + 1` iterates
 ///   `max q − min q ≤ plateau_alpha·max q` and `max s − min s ≤ plateau_share` — what a user
 ///   measures no longer changes even if `F` still creeps down along the flat directions of
-///   `F_AO` (seed 000 (6.8); the diagonal line slides of #4's note). Needs a quality probe;
+///   `F_AO` ([Méndez 2023, (6.8)]; the diagonal shear waves of docs/benchmarks.md, "Why 1000² in
+///   5 s is out of reach at σ = 0.1"). Needs a quality probe;
 ///   without one this test is off.
 ///
 /// The projected-gradient test is GTOL ([`SolverOptions::gtol`], [`SolverOptions::gtol_abs`]):

@@ -1,4 +1,4 @@
-//! Termination reasons and the UNAMALLA status messages (seed 001 digest §7.3, Table A.2).
+//! Termination reasons and the UNAMALLA status messages ([González Flores, Table A.2]).
 
 use std::fmt;
 

@@ -1,6 +1,6 @@
-//! The homotopy paths σ̃(t) of González Flores' UNAMALLA thesis (§5.3, (5.16)–(5.18)) in the
-//! double homotopy (§5.4, (5.19)–(5.20)), and the classic combinations t-Area–Length and
-//! t-Area–Orthogonality (§5.2 Table 5.1), against hand values.
+//! The homotopy paths σ̃(t) of [González Flores, §5.3, (5.16)–(5.18)] in the double homotopy
+//! (§5.4, (5.19)–(5.20)), and the classic combinations t-Area–Length and t-Area–Orthogonality
+//! (Table 5.1), against hand values.
 
 use std::sync::Arc;
 

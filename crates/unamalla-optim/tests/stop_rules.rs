@@ -1,5 +1,6 @@
-//! The window tests of `StopRules` and the explicit time limit (issue #23 item 1): a run ends
-//! where the rule, applied by hand to the history of a run without it, says it must.
+//! The window tests of `StopRules` and the explicit time limit (the smoothing stops on convergence,
+//! not on the clock): a run ends where the rule, applied by hand to the history of a run without
+//! it, says it must.
 
 use std::sync::Arc;
 

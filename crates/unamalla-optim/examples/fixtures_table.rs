@@ -1,14 +1,15 @@
 //! Runs every solver with the adaptive-k driver and with Algorithm A on the folded TFI grids
-//! of the seed 001 fixtures and prints the Markdown table of `docs/benchmarks.md`.
+//! of the test regions of [González Flores] (`unamalla_optim::fixtures`; the references are listed
+//! in `docs/references.md` of the repository) and prints the Markdown table of
+//! `docs/benchmarks.md`.
 //!
-//! `cargo run --release -p unamalla-optim --example seed001_table`
+//! `cargo run --release -p unamalla-optim --example fixtures_table`
 //!
 //! With the argument `options` it prints instead the table of the options added for the
-//! source's remaining rows (docs/results.md, section "Seed 001 options: homotopy paths, …"):
-//! the paths `t²`, `t³`, `sin(πt/2)` (González Flores, UNAMALLA thesis, §5.3), L-BFGS with
-//! `m = 3`, pointwise Newton by components, the classic combinations t-Area–Length (σ = 0.5,
-//! 0.9) and t-Area–Orthogonality (Table 5.1), and Ivanenko's convex-mesh functional (§2.2
-//! (2.50)).
+//! source's remaining rows (docs/results.md, section "González Flores options: homotopy paths,
+//! …"): the paths `t²`, `t³`, `sin(πt/2)` ([González Flores, §5.3]), L-BFGS with `m = 3`,
+//! pointwise Newton by components, the classic combinations t-Area–Length (σ = 0.5, 0.9) and
+//! t-Area–Orthogonality (Table 5.1), and Ivanenko's convex-mesh functional ((2.50)).
 
 use std::sync::Arc;
 
