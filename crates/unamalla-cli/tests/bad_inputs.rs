@@ -1,4 +1,4 @@
-//! The bad-input catalogue of issue #14 (`tests/bad_inputs/cases.json`), run through the
+//! The bad-input catalogue (`tests/bad_inputs/cases.json`, `docs/reliability.md`), run through the
 //! `unamalla` binary: for every case with a CLI command, a failing case exits non-zero with
 //! exactly one line on stderr (starting `error: `), no panic text, and leaves neither its
 //! output file nor any temporary file in the scratch directory; an accepted case ("ok") exits

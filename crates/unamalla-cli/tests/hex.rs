@@ -1,5 +1,5 @@
-//! End-to-end tests of `unamalla hex` (seed 004): the built-in box through Algorithms A and
-//! B, a perturbed sphere through Algorithm A, a directory of six face grids, and bad input.
+//! End-to-end tests of `unamalla hex` (Cortés Aguirre 2012): the built-in box through Algorithms A
+//! and B, a perturbed sphere through Algorithm A, a directory of six face grids, and bad input.
 
 mod common;
 use common::{bin, report, tmpdir, RunOk};

@@ -1,5 +1,5 @@
-//! The hostile-input catalogue of issue #24, run through the `unamalla` binary (and, at the
-//! end, the library API).
+//! The hostile-input catalogue (`docs/reliability.md`, "The hostile catalogue"), run through the
+//! `unamalla` binary (and, at the end, the library API).
 //!
 //! Every case asserts: the exit code (0 ok, 1 input, 2 usage, 3 guarantee not met, 4 other),
 //! a message naming the problem, no panic/abort text, and the file-system state: a failed run
@@ -263,7 +263,7 @@ fn run_case(c: &Case, scratch: &Path) -> Result<Output, String> {
     for (k, v) in &c.env {
         cmd.env(k, v);
     }
-    // a run that does not end within the bound is a failure (the hang cases of issue #24)
+    // a run that does not end within the bound is a failure (the hang cases)
     let o = output_within(cmd, std::time::Duration::from_secs(600))
         .map_err(|e| format!("{}: {e}", c.name))?;
     let stderr = String::from_utf8_lossy(&o.stderr).to_string();
@@ -1323,11 +1323,12 @@ fn million_vertex_ring_without_simplification_is_refused_promptly() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// Slow: the five example commands of issue #24 and the hang cases.
+/// Slow: the commands first reported as failing (Texas at 3,000 cells with and without
+/// simplification) and the hang cases.
 /// `cargo test -p unamalla-cli --test hostile -- --ignored`
 #[test]
 #[ignore]
-fn issue_examples_and_hang_cases() {
+fn reported_commands_and_hang_cases() {
     let tx = fixture("texas.geojson");
     let cases = vec![
         case(

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::Output;
 
 /// TFI grid of a bundled region; a folded grid (Texas at 61 × 61) is written with
-/// `--allow-non-convex` and exit code 3 (issue #24).
+/// `--allow-non-convex` and exit code 3 (a guarantee not met).
 fn tfi(region: &str, size: &str, out: &Path) {
     let o = bin()
         .arg("tfi")

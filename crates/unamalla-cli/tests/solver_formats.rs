@@ -1,5 +1,5 @@
-//! Issue #26: named boundary patches through `unamalla mesh` to Gmsh, SU2, OpenFOAM (and CGNS
-//! with `--features cgns`), checked by the formats' own tools through
+//! Solver formats and GIS input: named boundary patches through `unamalla mesh` to Gmsh, SU2,
+//! OpenFOAM (and CGNS with `--features cgns`), checked by the formats' own tools through
 //! `scripts/check_solver_formats.py`; lon/lat input meshed in km; `report.html` rendered by
 //! headless Chromium; `quality` on every mesh format `mesh` writes.
 //!
