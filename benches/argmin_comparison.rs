@@ -2,10 +2,10 @@
 //! search) and L-BFGS against argmin 0.11's L-BFGS, Newton-CG and Steihaug trust region, on the
 //! same problems through `unamalla_optim::argmin_adapter`.
 //!
-//! Problem: Winslow's functional `Σ l/α` (Winslow 1966; seed 001 (2.55)) on the TFI grid of the
-//! sinusoidal square (`fixtures::sinusoidal(n, n, 0.08, 2.0)`, convex), `n` = 100 and 300 nodes
-//! per side (19,208 and 177,608 variables). Every solver starts from the TFI grid and stops at
-//! the first iterate with `F − F* ≤ 10⁻⁶ (F₀ − F*)`, where `F*` is our TN-TR's minimum at
+//! Problem: Winslow's functional `Σ l/α` ([Winslow 1966]; [González Flores, (2.55)]) on the TFI
+//! grid of the sinusoidal square (`fixtures::sinusoidal(n, n, 0.08, 2.0)`, convex), `n` = 100 and
+//! 300 nodes per side (19,208 and 177,608 variables). Every solver starts from the TFI grid and
+//! stops at the first iterate with `F − F* ≤ 10⁻⁶ (F₀ − F*)`, where `F*` is our TN-TR's minimum at
 //! GTOL 10⁻¹⁰ (computed once, untimed); an iteration cap ends a run that does not get there
 //! (reported on stderr with the iterations, `F − F*` and whether the result is convex).
 //!

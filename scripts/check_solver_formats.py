@@ -1,5 +1,5 @@
 """Reads the solver files of a `unamalla mesh` output directory with the formats' own tools and
-prints one JSON object of what each found (issue #26). A tool that is not installed gives
+prints one JSON object of what each found. A tool that is not installed gives
 {"skipped": "<why>"} for its entry; the Rust tests (crates/unamalla-cli/tests/solver_formats.rs)
 compare the findings with the mesh.
 

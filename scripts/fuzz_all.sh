@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every cargo-fuzz target of fuzz/ for a fixed time, one after the other, and records the
-# figures (issue #14; the results table is in docs/reliability.md).
+# figures (the results table is in docs/reliability.md).
 #
 #   scripts/fuzz_all.sh SECONDS [TARGET ...]
 #

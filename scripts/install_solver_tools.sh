@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the solver and GIS tools the cross-check tests use (issue #26). Every test that needs
+# Installs the solver and GIS tools the cross-check tests use. Every test that needs
 # one of them prints "skipped: ..." and passes when it is absent, so this script is optional.
 #
 #   * OpenFOAM's checkMesh            Debian package `openfoam`

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Writes fixtures/synthetic/archipelago-<n>.geojson: a 200 × 120 sea (box) with n small
 islands (irregular heptagons, radius 0.35–0.9) placed along five curved chains, at least 1.2
-apart (edge to edge ≥ 0.3 for the largest pairs). Deterministic (seeded). Issue #22 item 4:
-a sea with hundreds of small islands must be meshed, not rejected.
+apart (edge to edge ≥ 0.3 for the largest pairs). Deterministic (seeded). The test case for
+the requirement that a sea with hundreds of small islands be meshed, not rejected.
 
     python3 scripts/make_archipelago.py 500 > fixtures/synthetic/archipelago-500.geojson
 """

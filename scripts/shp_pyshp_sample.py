@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes shapefile samples with pyshp (an independent writer and reader, PyPI `pyshp`) and
 records how pyshp reads them back, for the comparison test
-`crates/unamalla-io/tests/shapefile_pyshp.rs` (issue #14).
+`crates/unamalla-io/tests/shapefile_pyshp.rs` (see docs/reliability.md).
 
     pip install pyshp
     python3 scripts/shp_pyshp_sample.py [OUT_DIR]   # default crates/unamalla-io/tests/data/pyshp

@@ -1,6 +1,6 @@
 //! End-to-end over real bundled regions, through the facade a user adds (`unamalla-core`), with
 //! the product's promises checked independently of the pipeline's own report: every cell
-//! convex (all four corner cross products positive, seed 000 digest §5.5), no interior
+//! convex (all four corner cross products positive, [Méndez 2023, §6.4.2]), no interior
 //! singularity (every interior node in exactly four cells) and the requested cell count within
 //! ±15 % (the targets of README "Status").
 

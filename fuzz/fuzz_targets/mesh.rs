@@ -4,10 +4,10 @@
 //! with up to three star-shaped holes anywhere (often crossing the outer ring or each other:
 //! rejected), 16 to 415 cells, with or without contour simplification.
 //!
-//! Oracle (issue #24's guarantee): no panic; a mesh returned as `Ok` passed its own
-//! verification, and the independent check `verify_quads` against the meshed region agrees
-//! (no non-convex cell, no centroid outside); an error is allowed (a valid region may be
-//! unmeshable at the size), but its message is not empty. Hangs are found by libFuzzer's
+//! Oracle (docs/reliability.md, "The guarantee holds or the run fails"): no panic; a mesh returned
+//! as `Ok` passed its own verification, and the independent check `verify_quads` against the meshed
+//! region agrees (no non-convex cell, no centroid outside); an error is allowed (a valid region may
+//! be unmeshable at the size), but its message is not empty. Hangs are found by libFuzzer's
 //! `-timeout` (see `scripts/fuzz_all.sh`).
 #![no_main]
 use arbitrary::Arbitrary;
