@@ -5,6 +5,7 @@ use thiserror::Error;
 /// Everything that can go wrong with user input to this crate. Each variant names the offending
 /// item (which knot, which boundary curve, which corner, which option).
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum BsplineError {
     /// The order (degree + 1) is outside the supported range.
     #[error("order {order} is not supported here ({reason})")]

@@ -9,6 +9,7 @@ use crate::problem::Side;
 /// Errors returned by this crate. Every variant that comes from user input names the offending block,
 /// side, curve or cut by the **ids** the user gave them.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CompatError {
     /// The problem has no block.
     #[error("the decomposition has no block")]

@@ -4,6 +4,7 @@ use unamalla_mesh::GeometryError;
 
 /// Why a simplification could not be carried out.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ContourError {
     /// A method name that is not one of [`crate::Method::NAMES`].
     #[error("unknown simplification method `{name}`; valid methods: {valid}")]

@@ -44,6 +44,7 @@ static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Errors of [`OutputDir`] and [`OutputFiles`]. Every variant names the path.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum OutputError {
     /// A file-system operation failed.
     #[error("{path}: {action}: {source}")]

@@ -63,6 +63,7 @@ pub const MIN_GAP_FRACTION: f64 = 0.01;
 
 /// Errors of the checks before the work.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum PreflightError {
     /// A size needs more memory than the limit.
     #[error(

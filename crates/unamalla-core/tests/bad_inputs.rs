@@ -38,6 +38,7 @@ fn variant(e: &CoreError) -> String {
             GeometryError::RingsIntersect { .. } => "RingsIntersect",
             GeometryError::HoleOutside { .. } => "HoleOutside",
             GeometryError::NestedHole { .. } => "NestedHole",
+            _ => "other",
         }
     }
     match e {

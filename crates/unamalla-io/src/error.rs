@@ -12,6 +12,7 @@ use unamalla_mesh::{GeometryError, MeshError};
 
 /// Why reading or writing a file failed.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum IoError {
     /// The operating system reported an error (open, read, write, sync, rename).
     #[error("{}: {source}", .path.display())]

@@ -23,6 +23,7 @@ impl fmt::Display for RingId {
 /// Why a polygon or region was rejected. Vertex and edge indices refer to the ring **as given**
 /// (before any orientation normalisation; edge `e` joins vertex `e` and vertex `e + 1`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum GeometryError {
     /// A ring needs at least three distinct points.
     #[error("{ring}: {count} distinct point(s), a ring needs at least 3")]
@@ -113,6 +114,7 @@ pub enum GeometryError {
 
 /// Errors of mesh construction and mesh operations.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum MeshError {
     /// A size is too small or inconsistent.
     #[error("invalid size: {0}")]

@@ -6,6 +6,7 @@ use crate::error::MeshError;
 /// [`HexFaceId`](super::HexFaceId) (`i_min` … `k_max`, with the thesis's names M1–M6 in the
 /// message), nodes by their 0-based logical indices `(i, j, k)` in the volume grid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum HexGenError {
     /// A size is too small (a logically hexahedral region needs at least 2 nodes per
     /// direction; some functions need more, e.g. appendix A needs 4).
