@@ -41,7 +41,7 @@ fn baseline_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/baseline_outputs.txt")
 }
 
-/// Minimal GeoJSON Polygon reader (same as `examples/simplify_table.rs`).
+/// Minimal GeoJSON Polygon reader (same as `studies/common/load.rs`).
 fn load(path: &std::path::Path) -> Region {
     let text = std::fs::read_to_string(path).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
