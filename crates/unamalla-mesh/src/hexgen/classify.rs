@@ -1,4 +1,5 @@
-//! Cell classification and admissibility (seed 004 digest §3.3).
+//! Cell classification and admissibility ([Cortés Aguirre 2012, §3.3]; the references
+//! are listed in `docs/references.md` of the repository).
 //!
 //! With boundary nodes fixed, a cell of a structured hex grid is
 //! * a **corner** cell: 7 boundary nodes, 5 of its 10 tetrahedra have only fixed vertices;
@@ -7,7 +8,7 @@
 //! * an **interior** cell: no boundary node (for a grid, `1 ≤ i ≤ m−3` etc. 0-based; the
 //!   thesis's `1 < i < m−1`, 1-based). Algorithm B's planarity penalty acts on these.
 //!
-//! There are 8 corner cells, not 4 as printed (digest erratum 10). A grid with fewer than 4
+//! There are 8 corner cells (the thesis says four). A grid with fewer than 4
 //! nodes along some direction has cells with other counts (e.g. 8 fixed nodes when `m = 2`);
 //! they are [`CellClass::Other`].
 //!
@@ -180,7 +181,7 @@ mod tests {
 
     #[test]
     fn corner_cells_have_five_fixed_tets_and_edge_cells_two() {
-        // digest §3.3: corner cell → 5 fixed tets, edge cell → 2, face/interior → 0
+        // [Cortés Aguirre 2012, §3.3]: corner cell → 5 fixed tets, edge cell → 2, face/interior → 0
         let g = grid(5, 5, 5);
         let cls = classify_cells(&g);
         for (c, cl) in cls.iter().enumerate() {

@@ -1,4 +1,5 @@
-//! Appendix A of seed 004: counting variables against planarity constraints.
+//! [Cortés Aguirre 2012, Appendix A] (the references are listed in `docs/references.md` of the
+//! repository): counting variables against planarity constraints.
 //!
 //! For an `m × n × p` grid (`m, n, p ≥ 4` nodes) with `M = m−2`, `N = n−2`, `P = p−2`
 //! (free nodes per direction):
@@ -121,7 +122,7 @@ mod tests {
 
     #[test]
     fn table_a1_samples() {
-        // digest §7: A1 samples 444→18, 555→45, 666→84, 777→135, 888→198, 10³→360
+        // [Cortés Aguirre 2012, Table A1]: 444→18, 555→45, 666→84, 777→135, 888→198, 10³→360
         for (n, want) in [(4, 18), (5, 45), (6, 84), (7, 135), (8, 198), (10, 360)] {
             assert_eq!(planarity_counts(n, n, n).unwrap().dof, want, "{n}³");
         }
@@ -182,7 +183,8 @@ mod tests {
     #[test]
     fn appendix_examples() {
         // 5³: removing 3 blocks of 12 leaves 72 constraints for 81 variables (margin 9);
-        // freeing 9 boundary nodes gives 108 = 108 (margin 0, erratum 12)
+        // freeing 9 boundary nodes gives 108 = 108 (margin 0: an equality, though the thesis
+        // calls it well posed, [Cortés Aguirre 2012, §A.3.4])
         let c = planarity_counts(5, 5, 5).unwrap();
         assert_eq!(
             (c.variables, c.interior_block_faces, c.f_int),

@@ -1,4 +1,5 @@
-//! Initial hexahedral meshes from a 2D mesh (seed 004 digest §2.2.2–§2.2.3): the 2D nodes
+//! Initial hexahedral meshes from a 2D mesh ([Cortés Aguirre 2012, §2.2.2–§2.2.3];
+//! the references are listed in `docs/references.md` of the repository): the 2D nodes
 //! are projected vertically onto a plane or a surface `z = f(x, y)` and the volume is built by
 //!
 //! * **(i) layers** ([`Extrusion::Layers`]): project once, onto the base (copies stacked
@@ -12,7 +13,7 @@
 //! The surfaces are anything implementing [`HeightField`]: a [`Plane`], a closure
 //! `Fn(f64, f64) -> f64` (e.g. the thesis's `0.5x³ − 0.3y²`), or a [`Shepard`] interpolant of
 //! scattered data. Vertical columns keep every cell's side faces vertical; convexity is not
-//! guaranteed in case (ii) (digest §2.2.2), which is why Algorithm A follows.
+//! guaranteed in case (ii) ([Cortés Aguirre 2012, §2.2.2]), which is why Algorithm A follows.
 //!
 //! Layer `k` of a 2D grid `m × n` becomes the `k`-th `(i, j)` slice of an `m × n × p` grid, so
 //! counter-clockwise 2D cells give hexahedra in VTK order with positive orientation.

@@ -1,11 +1,12 @@
-//! Generators of structured hexahedral meshes on logically hexahedral regions (seed 004
-//! digest §2–§3, App. A).
+//! Generators of structured hexahedral meshes on logically hexahedral regions
+//! ([Cortés Aguirre 2012, Ch. 2–3, Appendix A]; the references are listed in
+//! `docs/references.md` of the repository; the section numbers below are the thesis's).
 //!
 //! * [`region`]: a region from six structured face grids with compatibility checks
 //!   (opposite faces of equal size, shared edges coincident; Def. 6), and its initial mesh by
 //!   3D TFI ([`tfi3`](crate::tfi3), §2.2.1);
 //! * [`radial`]: the radial map `x ↦ x·‖x‖∞/‖x‖₂` of the cube onto the ball and, scaled, onto
-//!   an ellipsoid (§2.1.1, recommended reading);
+//!   an ellipsoid (§2.1.1; the thesis does not print the formula, ours is in the module);
 //! * [`extrude`]: a 2D mesh projected onto a plane or `z = f(x, y)` and extruded with a list
 //!   of layer thicknesses, or interpolated between a base and a top surface (§2.2.2);
 //! * [`shepard`]: Shepard interpolation of scattered `(x, y, z)` data for those surfaces

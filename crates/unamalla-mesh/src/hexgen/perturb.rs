@@ -1,6 +1,7 @@
 //! Seeded random perturbation of the free (interior) nodes, to create folded starts
-//! (seed 004 digest §2.2.3: "Meshes may be perturbed on purpose to get non-convex inputs";
-//! the Esfera example is "perturbed to 22 non-convex cells", §3.4.3).
+//! ([Cortés Aguirre 2012, §2.2.3]: initial meshes may be perturbed to get a wider range of
+//! starts; the Esfera example is perturbed until 22 cells are non-convex, §3.4.3. The references
+//! are listed in `docs/references.md` of the repository).
 //!
 //! Each free node `v` moves by `s·h_v·u`, where `h_v` is the length of the shortest mesh edge
 //! at `v` and `u` is uniform in the unit ball (rejection sampling of the cube `[−1, 1]³`).

@@ -1,6 +1,7 @@
 //! The radial map of the cube `[−1, 1]³` onto the unit ball, and ellipsoids by scaling
-//! (seed 004 digest §2.1.1 and §10, recommended reading \[I\]: the thesis does not print the
-//! formula).
+//! ([Cortés Aguirre 2012, §2.1.1, §3.4.3]; the references are listed in `docs/references.md` of
+//! the repository). The thesis names the radial map of the cube but does not print its formula;
+//! the one below is our choice.
 //!
 //! ```text
 //! R(x) = x · ‖x‖∞ / ‖x‖₂          (R(0) = 0)
@@ -10,9 +11,9 @@
 //! `R` maps every cube shell `‖x‖∞ = t` onto the sphere of radius `t`, so each cube face
 //! becomes one sixth of the sphere (one face of the logically hexahedral ball) and the
 //! boundary of a uniform cube grid lies exactly on the sphere. It is continuous and piecewise
-//! smooth; the cube's edges leave kinks along the diagonal planes ("the cube edges leave kinks
-//! that propagate inward", digest §3.4.3), and the eight corner cells have a nearly flat
-//! (close to 180°) boundary angle, so their fixed tetrahedra are thin but positive.
+//! smooth; the cube's edges leave kinks along the diagonal planes (the thesis notes that they
+//! propagate into the mesh, [Cortés Aguirre 2012, §3.4.3]), and the eight corner cells have a
+//! nearly flat (close to 180°) boundary angle, so their fixed tetrahedra are thin but positive.
 
 use glam::DVec3;
 
@@ -31,7 +32,7 @@ pub fn cube_to_ball(x: DVec3) -> DVec3 {
 
 /// The uniform `m × n × p` grid of `[−1, 1]³` mapped by [`cube_to_ball`] and scaled by the
 /// semi-axes `axes = (a, b, c)` about `centre`: every node is mapped, so the start is the
-/// convex "radial" mesh of the Esfera / Elipsoide examples (digest §3.4.3).
+/// convex "radial" mesh of the Esfera / Elipsoide examples ([Cortés Aguirre 2012, §3.4.3, §5.2]).
 ///
 /// ```
 /// use unamalla_mesh::hexgen::ellipsoid_grid;
@@ -112,7 +113,7 @@ mod tests {
 
     #[test]
     fn the_radial_start_is_convex() {
-        // digest §3.4.3: "It is convex" (before the perturbation)
+        // [Cortés Aguirre 2012, §3.4.3]: the radial mesh is convex (before the perturbation)
         for n in [5, 10, 20] {
             let g = ellipsoid_grid((n, n, n), DVec3::new(0.5, 1.0, 0.5), DVec3::ZERO).unwrap();
             assert_eq!(hex_non_convex_count(&g, 0.0), 0, "n = {n}");

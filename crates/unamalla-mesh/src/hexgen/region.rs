@@ -1,5 +1,6 @@
-//! Logically hexahedral regions given by six structured face grids (seed 004 digest §2.1,
-//! Def. 6): opposite faces have the same size and faces sharing an edge coincide on it.
+//! Logically hexahedral regions given by six structured face grids
+//! ([Cortés Aguirre 2012, §2.1, Def 6]; the references are listed in `docs/references.md` of
+//! the repository): opposite faces have the same size and faces sharing an edge coincide on it.
 
 use glam::DVec3;
 
@@ -9,9 +10,9 @@ use crate::tfi::{tfi3, HexFaces};
 
 /// One of the six faces of a logically hexahedral region.
 ///
-/// The thesis's numbering (seed 004 digest §3.2, (3.16)) is given by [`HexFaceId::thesis_name`]:
-/// M1 = `j = 1`, M2 = `i = 1`, M3 = `j = n`, M4 = `i = m`, M5 = `k = 1` (bottom),
-/// M6 = `k = p` (top), 1-based.
+/// The thesis's numbering ([Cortés Aguirre 2012, §3.2, (3.16)]) is given by
+/// [`HexFaceId::thesis_name`]: M1 = `j = 1`, M2 = `i = 1`, M3 = `j = n`, M4 = `i = m`,
+/// M5 = `k = 1` (bottom), M6 = `k = p` (top), 1-based.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum HexFaceId {
     /// Face `i = 0` (M2, "left").
@@ -81,8 +82,8 @@ impl HexFaceId {
     }
 }
 
-/// A structured surface grid of `a × b` points, stored at `y·a + x` (seed 004 digest §2.1,
-/// Def. 5). Which logical directions `x, y` are depends on the face (see [`HexFaces`]):
+/// A structured surface grid of `a × b` points, stored at `y·a + x` ([Cortés Aguirre 2012,
+/// §2.1, Def 5]). Which logical directions `x, y` are depends on the face (see [`HexFaces`]):
 /// `(j, k)` on the `i` faces, `(i, k)` on the `j` faces, `(i, j)` on the `k` faces.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FaceGrid {
@@ -107,7 +108,7 @@ impl FaceGrid {
     }
 }
 
-/// A validated logically hexahedral region (seed 004 digest §2.1, Def. 6).
+/// A validated logically hexahedral region ([Cortés Aguirre 2012, §2.1, Def 6]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct HexRegion {
     faces: HexFaces,
@@ -304,8 +305,9 @@ impl HexRegion {
         face_of(&self.faces, id).0
     }
 
-    /// The initial mesh by 3D transfinite interpolation (seed 004 digest §2.2.1, the Boolean
-    /// sum of [`tfi3`]); the boundary nodes are the face points exactly.
+    /// The initial mesh by 3D transfinite interpolation ([Cortés Aguirre 2012, §2.2.1], which
+    /// does not print the formula; the Boolean sum of [`tfi3`]); the boundary nodes are the face
+    /// points exactly.
     pub fn tfi(&self) -> Result<StructuredGrid3, HexGenError> {
         Ok(tfi3(&self.faces)?)
     }

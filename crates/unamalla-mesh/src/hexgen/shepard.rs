@@ -1,6 +1,7 @@
 //! Shepard interpolation of scattered `(x, y, z)` data, for top and base surfaces
-//! (seed 004 digest §2.2.3: "f(x,y) or scattered observations, interpolated with Shepard
-//! [Renka 1988]").
+//! ([Cortés Aguirre 2012, §2.2.3, Fig. 2.13]: a function `f(x, y)` or scattered observations,
+//! interpolated with Shepard's method as in [Renka 1988]; the references are listed in
+//! `docs/references.md` of the repository).
 //!
 //! With data `(x_k, f_k)`, `k = 1..N`, and `d_k = ‖x − x_k‖`:
 //!
