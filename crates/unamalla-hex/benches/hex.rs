@@ -1,4 +1,6 @@
-//! Criterion benchmarks of the structured hexahedral pipeline (issue #10, seed 004):
+//! Criterion benchmarks of the structured hexahedral pipeline ([Cortés Aguirre 2012]; the
+//! references are listed in `docs/references.md` of the repository; the results are in
+//! `docs/benchmarks.md`, "Structured hexahedral meshes"):
 //!
 //! * `hex/algorithm_a/sphere20`: Algorithm A (`run_hex` with the default options, A only) on
 //!   the perturbed sphere 20³ of the thesis (seed 1; grid construction and perturbation are

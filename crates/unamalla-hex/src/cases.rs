@@ -1,7 +1,8 @@
-//! The built-in logically hexahedral regions (digest §10) and their initial meshes: the radial
-//! map of the cube onto the ball and the ellipsoid, extrusion of a plan-view grid between two
-//! surfaces, six analytic face grids filled by 3D TFI, and the Shepard surface of the reservoir
-//! stand-in.
+//! The built-in logically hexahedral regions (after the test regions of [Cortés Aguirre 2012,
+//! §3.4.1, Table 3.1], the box of its chapter 4 and the ellipsoid of §2.1.1; the references are
+//! listed in `docs/references.md` of the repository) and their initial meshes: the radial map of
+//! the cube onto the ball and the ellipsoid, extrusion of a plan-view grid between two surfaces,
+//! six analytic face grids filled by 3D TFI, and the Shepard surface of the reservoir stand-in.
 
 use std::f64::consts::PI;
 use std::fmt;
@@ -16,7 +17,7 @@ use unamalla_mesh::{DVec2, DVec3, StructuredGrid2, StructuredGrid3};
 
 use crate::{HexError, Perturbation};
 
-/// The built-in logically hexahedral regions (digest §10).
+/// The built-in logically hexahedral regions (after [Cortés Aguirre 2012, §3.4.1, Table 3.1]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum HexCase {

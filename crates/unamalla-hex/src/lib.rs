@@ -1,10 +1,11 @@
 //! # unamalla-hex
 //!
-//! Structured hexahedral meshes on logically hexahedral regions (seed 004): built-in test
-//! regions, initial meshes, Algorithm A (convex harmonic) and Algorithm B (planar faces), the
-//! run report and the output files.
+//! Structured hexahedral meshes on logically hexahedral regions ([Cortés Aguirre 2012]; the
+//! references are listed in `docs/references.md` of the repository): built-in test regions, initial
+//! meshes, Algorithm A (convex harmonic) and Algorithm B (planar faces), the run report and the
+//! output files.
 //!
-//! # Pipeline (seed 004 digest §0)
+//! # Pipeline (section, table and definition numbers are the thesis's)
 //! 1. **Region and initial mesh** ([`HexCase::initial_grid`], [`read_face_dir`]): six face
 //!    grids + 3D TFI, the radial cube → ball/ellipsoid map, or extrusion of a 2D grid between
 //!    two surfaces (generators in [`unamalla_mesh::hexgen`]);
@@ -24,18 +25,20 @@
 //!    choice is explained on
 //!    [`coplanarity_continuation`](unamalla_optim::drivers::coplanarity_continuation)); the
 //!    convexity safeguard keeps the mesh convex;
-//! 6. **report** ([`HexRunReport`], §9 and App. B "information panel"): non-convex cells
+//! 6. **report** ([`HexRunReport`], the measures of §3.2.1 and §4.1 and the information panel
+//!    of §B.3): non-convex cells
 //!    (10-tetrahedra test with ε), non-hexahedral interior cells (some face with
 //!    `|cos| ≥ 10⁻²`, criterion 2 of §4.1), max `|cos|`, min/max tetrahedron volume, Verdict
 //!    scaled Jacobian min/p5, iterations, time, and the histograms of App. B.6 (tetrahedron
 //!    volume sign, face planarity, edge lengths) as data and as an SVG plot
 //!    ([`histograms_svg`]).
 //!
-//! # Built-in regions ([`HexCase`], digest §10)
+//! # Built-in regions ([`HexCase`], [Cortés Aguirre 2012, §3.4.1, Table 3.1])
 //! `sphere` and `ellipsoid` (semi-axes 0.5, 1, 0.5) and the chapter 4 `box` are the thesis's
 //! exactly reconstructible regions. `pico`, `cosin`, `shell` and `parabs` are **analytic
 //! stand-ins** with the thesis's bounding boxes: the thesis does not give their surfaces
-//! (digest §10, "Approx"); each variant's documentation gives the formula used.
+//! (§3.4.1 describes them in words and gives their domains); each variant's documentation gives
+//! the formula used.
 //! `elipsoideg`, `yacimiento` and `sydney` (Cortés Aguirre 2012, Table 3.1) are
 //! reconstructions too: the thesis gives their domains and constructions, not every surface or
 //! datum, and each variant's documentation says what is ours.
@@ -64,7 +67,7 @@
 
 #![warn(missing_docs)]
 // user input (case names, face-grid files, options) reaches every function: no unwrap/expect
-// outside tests (issue #14)
+// outside tests (docs/reliability.md, section 3)
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod cases;

@@ -9,7 +9,8 @@ use unamalla_optim::SmoothReport;
 
 use crate::HexRunOptions;
 
-/// Mesh measures at one stage of a run (digest §9; App. B information panel).
+/// Mesh measures at one stage of a run (the convexity test of [Cortés Aguirre 2012, §3.2.1,
+/// (3.35)], the planarity of §4.1 and the information panel of §B.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HexMeasures {
     /// Cells failing the 10-tetrahedra test `V > ε·v̄` (ε of Algorithm A, `v̄` the mean of all

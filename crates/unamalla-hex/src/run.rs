@@ -64,7 +64,9 @@ pub enum HexAlgorithm {
     AB,
 }
 
-/// The tetrahedron Jacobian scaling (digest §3.2 "Scaling", erratum 6).
+/// The tetrahedron Jacobian scaling: [Cortés Aguirre 2012, §3.2] prints raw vertex differences,
+/// but its reported values fit only unit-parametric Jacobians (our reading; see
+/// `unamalla_functionals::hex`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum HexScaling {
     /// Raw vertex differences, as printed in the thesis.
@@ -244,7 +246,8 @@ mod tests {
 
     #[test]
     fn algorithm_a_turns_the_perturbed_sphere_20_convex() {
-        // the thesis's Esfera: 20³, perturbed to ≥ 22 non-convex cells (digest §3.4.3)
+        // the thesis's Esfera: 20³, perturbed to ≥ 22 non-convex cells
+        // ([Cortés Aguirre 2012, §3.4.3])
         let case = HexCase::Sphere;
         let dims = case.default_size();
         let mut g = case.initial_grid(dims).unwrap();
@@ -381,7 +384,7 @@ mod tests {
         assert_eq!(t.algorithm_b.as_ref().unwrap().continuation_steps, 12);
         assert!(b.iterations < t.algorithm_b.as_ref().unwrap().iterations);
     }
-    /// Issue #10 regression: the Pico-like 21³ case (seed 1) stalled with the thesis's
+    /// Regression: the Pico-like 21³ case (seed 1) stalled with the thesis's
     /// schedule (every μ step at its 50-iteration limit, 12 non-hexahedral and 16
     /// non-ε-convex cells left); the default schedule must finish it (measured: 172 B
     /// iterations, 6 μ steps). ≈ 1 min: `cargo test -p unamalla-hex --release --lib --

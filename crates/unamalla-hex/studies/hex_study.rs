@@ -1,5 +1,6 @@
-//! Measurements behind issue #10 (structured hex meshes, seed 004): Algorithm A speed and its
-//! variants, and Algorithm B's μ schedule. Every number in the hex sections of
+//! Measurements behind the structured hexahedral meshes of [Cortés Aguirre 2012] (the references
+//! are listed in `docs/references.md` of the repository): Algorithm A speed and its variants, and
+//! Algorithm B's μ schedule. Every number in the hex sections of
 //! `docs/benchmarks.md` / `docs/results.md` that is not a plain `unamalla hex` run comes from here.
 //!
 //! ```sh
