@@ -6,8 +6,9 @@
 //! (Cortés Aguirre 2012, chapter 5). The crate depends only on `unamalla-mesh` (and on `faer`
 //! with the cargo feature `direct`).
 //!
-//! The elliptic solver is the "PDE solve" application of UNAMALLA (seed 001 digest §6 RF12,
-//! §7.3 *PDE Solver Control Panel*):
+//! The elliptic solver is the "PDE solve" application of UNAMALLA (functional requirement 12 of
+//! [González Flores, §6.1.7] and the *PDE Solver Control Panel* of §A.4.5; the references are
+//! listed in `docs/references.md` of the repository):
 //!
 //! ```text
 //! a·U_xx + 2b·U_xy + c·U_yy + d·U = g(x, y)   in Ω,     U = U_D on ∂Ω,
@@ -31,8 +32,9 @@
 //! J = x_ξ·y_η − x_η·y_ξ,   ξ_x = y_η/J,  ξ_y = −x_η/J,  η_x = −y_ξ/J,  η_y = x_ξ/J
 //! ```
 //!
-//! (the inverse-metric identities of seed 001 digest §9 item 3, eq. (2.11) with its missing
-//! minus signs restored). By the chain rule the operator `L = a∂xx + 2b∂xy + c∂yy` becomes
+//! (the inverse-metric identities of [González Flores, (2.11)], which prints `ξ_y = x_η/J` and
+//! `η_x = y_ξ/J` without their minus signs). By the chain rule the operator
+//! `L = a∂xx + 2b∂xy + c∂yy` becomes
 //!
 //! ```text
 //! L U = A₁₁ U_ξξ + 2A₁₂ U_ξη + A₂₂ U_ηη + P U_ξ + Q U_η,
@@ -82,9 +84,9 @@
 //!
 //! The transformation needs `J > 0`. Before anything is assembled the mesh is checked with
 //! [`unamalla_mesh::quality::corner_alphas`] (a cell is convex iff its four corner triangles
-//! have `α > 0`, seed 001 digest §1): a mesh with a non-convex cell is reported as
-//! [`PdeError::FoldedMesh`] and is not solved; a non-positive central-difference Jacobian at a
-//! node is [`PdeError::DegenerateMetric`].
+//! have `α > 0`; the triangles of [González Flores, (2.53), Fig 2.19]): a mesh with a non-convex
+//! cell is reported as [`PdeError::FoldedMesh`] and is not solved; a non-positive
+//! central-difference Jacobian at a node is [`PdeError::DegenerateMetric`].
 //!
 //! # Solvers
 //!
@@ -127,7 +129,7 @@
 //! ```
 
 #![warn(missing_docs)]
-// user input reaches the solvers: no unwrap/expect outside tests (issue #14)
+// user input reaches the solvers: no unwrap/expect outside tests (docs/reliability.md, section 3)
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod direct;
@@ -183,7 +185,7 @@ impl fmt::Debug for Source {
 /// direction of the boundary (bottom left → right, right bottom → top, top right → left, left
 /// top → bottom). The thesis describes each profile by its maximum value on the side,
 /// "starting from the corresponding vertices"; we read that as 0 at both ends for the parabola
-/// and the sine (inference, seed 001 digest §7.3).
+/// and the sine (our reading of [González Flores, §A.4.5]).
 #[derive(Clone)]
 pub enum SideValue {
     /// `U = value`.
