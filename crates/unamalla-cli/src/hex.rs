@@ -1,6 +1,7 @@
 //! `unamalla hex`: a structured hexahedral mesh of a built-in region or of a directory of six
 //! face grids, made convex by Algorithm A and (by default) given planar interior faces by
-//! Algorithm B (seed 004). Writes `mesh.vts`, `mesh.vtu`, `report.json` and
+//! Algorithm B ([Cortés Aguirre 2012, §3.4, §4.2]; the references are listed in
+//! `docs/references.md` of the repository). Writes `mesh.vts`, `mesh.vtu`, `report.json` and
 //! `histograms.svg` into the output directory.
 
 use std::path::PathBuf;

@@ -1,6 +1,7 @@
-//! `unamalla pde`: solve `a·U_xx + 2b·U_xy + c·U_yy + d·U = g` on a mesh file (seed 001
-//! digest §6 RF12, §7.3) with [`unamalla_pde`], and write the solution as VTK point data
-//! `u`, a Geomview `MESH` surface (structured grids) and PNG/SVG colour plots.
+//! `unamalla pde`: solve `a·U_xx + 2b·U_xy + c·U_yy + d·U = g` on a mesh file (the PDE
+//! application of [González Flores, §6.1.7, §A.4.5]; the references are listed in
+//! `docs/references.md` of the repository) with [`unamalla_pde`], and write the solution as VTK
+//! point data `u`, a Geomview `MESH` surface (structured grids) and PNG/SVG colour plots.
 
 use std::path::{Path, PathBuf};
 
