@@ -46,7 +46,7 @@ fn all_fixture_regions_decompose() {
 #[path = "common/pipeline.rs"]
 mod pipeline;
 
-/// Issue #6 on the regions as the default mesher sees them (`common/pipeline.rs`): **every
+/// The corner rules on the regions as the default mesher sees them (`common/pipeline.rs`): **every
 /// block is admissible** (approximately convex, no critical angle unless it is a triangle
 /// block), every quadrilateral block has four corners with an interior angle below 170°, no
 /// cut joint, and the decomposition graph has one cycle per hole.
@@ -77,7 +77,7 @@ fn pipeline_regions_meet_the_corner_rules() {
                 .unwrap_or_else(|e| panic!("{} {layout:?}: {e}", f.display()));
             d.validate(&region).unwrap();
             assert_eq!(d.graph_cycles(), region.holes().len(), "{}", f.display());
-            // issue #6: no corner inside a cut — every block vertex lies on the region boundary
+            // no corner inside a cut — every block vertex lies on the region boundary
             // (maryland had two such joints, the two interior singularities of its mesh)
             let joints = d.cut_joints(&region);
             assert!(

@@ -408,7 +408,7 @@ fn a_spike_tip_gets_a_cut_so_no_block_keeps_it() {
 
 #[test]
 fn a_sliver_island_keeps_no_spike_in_any_block() {
-    // the gulf-of-mexico case (issue #8) in miniature: a sliver island 60 long and 2 wide, tip
+    // a sliver island of gulf-of-mexico in miniature: an island 60 long and 2 wide, tip
     // angle 2·atan(1/60) ≈ 1.9°, so the region's angle at the tip is ≈ 358.1° > θ₊ = 350°
     let r = Region::new(
         vec![v(0., 0.), v(100., 0.), v(100., 100.), v(0., 100.)],

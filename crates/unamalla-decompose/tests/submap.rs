@@ -1,5 +1,6 @@
-//! Submapping (seed 002) on exact synthetic geometries — the digest §9.2 stand-ins for the
-//! paper's figures (which give no coordinates).
+//! Submapping ([Ruiz-Gironés & Sarrate]; the references are listed in `docs/references.md` of the
+//! repository) on exact synthetic geometries — our stand-ins for the paper's examples, which it
+//! shows as figures without coordinates.
 //!
 //! Every test checks: the expected vertex types (derived by hand from the turning angles, written
 //! next to each shape), `E − C − 2R = 4(1 − H)`, equal node counts on opposite sides of every
@@ -297,7 +298,8 @@ fn auto_rule() {
 
 #[test]
 fn equilateral_triangle_is_not_submappable() {
-    // three vertices of α = 4/3 can reach at most Σ = 3 < 4 (digest §7 [NOTE])
+    // three vertices of α = 4/3 can reach at most Σ = 3 < 4, so no classification meets
+    // condition (1) of [Ruiz-Gironés & Sarrate] (our remark)
     let s3 = 3f64.sqrt();
     let region = Region::new(ring(&[(0., 0.), (2., 0.), (1., s3)]), vec![]).unwrap();
     let e = submap(&region, &SubmapOptions::new(0.2)).unwrap_err();
