@@ -342,10 +342,14 @@ impl ChordMesh {
 
 /// The dual spanning tree of one simply connected piece of a [`ChordMesh`]: triangles in DFS
 /// preorder, each one's parent and the dual edge to it, and subtree areas.
+///
+/// `parent` and `sub` are indexed by triangle id (dense vectors over all the mesh's
+/// triangles; entries outside the piece stay `None` / 0): the same values, summed in the same
+/// order, as a map keyed by triangle would hold, without the map's per-entry work.
 struct PieceTree {
     order: Vec<usize>,
-    parent: BTreeMap<usize, (usize, usize)>,
-    sub: BTreeMap<usize, f64>,
+    parent: Vec<Option<(usize, usize)>>,
+    sub: Vec<f64>,
     total: f64,
 }
 
@@ -357,8 +361,10 @@ impl PieceTree {
         seed: usize,
         open: &dyn Fn(usize, usize) -> Option<usize>,
     ) -> Option<Self> {
-        let mut parent: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
-        let mut seen: HashSet<usize> = HashSet::from([seed]);
+        let nt = m.tris.len();
+        let mut parent: Vec<Option<(usize, usize)>> = vec![None; nt];
+        let mut seen = vec![false; nt];
+        seen[seed] = true;
         let mut dfs = vec![seed];
         let mut order = Vec::new();
         let mut dual_edges = 0usize;
@@ -367,8 +373,9 @@ impl PieceTree {
             for k in 0..3 {
                 if let Some(u) = open(x, k) {
                     dual_edges += 1;
-                    if seen.insert(u) {
-                        parent.insert(u, (x, k));
+                    if !seen[u] {
+                        seen[u] = true;
+                        parent[u] = Some((x, k));
                         dfs.push(u);
                     }
                 }
@@ -377,15 +384,17 @@ impl PieceTree {
         if dual_edges / 2 + 1 != order.len() {
             return None;
         }
-        let mut sub: BTreeMap<usize, f64> = BTreeMap::new();
+        // children before parents: a triangle's entry holds the sum of its children's
+        // subtrees (0.0 + s₁ + s₂ …, in this order) when it is reached
+        let mut sub = vec![0.0; nt];
         for &x in order.iter().rev() {
-            let s = m.tri_area(x) + sub.get(&x).copied().unwrap_or(0.0);
-            sub.insert(x, s);
-            if let Some(&(p, _)) = parent.get(&x) {
-                *sub.entry(p).or_insert(0.0) += s;
+            let s = m.tri_area(x) + sub[x];
+            sub[x] = s;
+            if let Some((p, _)) = parent[x] {
+                sub[p] += s;
             }
         }
-        let total = sub.get(&seed).copied().unwrap_or(0.0);
+        let total = sub[seed];
         Some(Self {
             order,
             parent,
@@ -401,9 +410,9 @@ impl PieceTree {
         m: &'a ChordMesh,
     ) -> impl Iterator<Item = (usize, usize, f64, usize)> + 'a {
         self.order.iter().filter_map(move |&x| {
-            let &(p, k) = self.parent.get(&x)?;
+            let (p, k) = self.parent[x]?;
             let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
-            Some((a, b, self.sub.get(&x).copied().unwrap_or(0.0), x))
+            Some((a, b, self.sub[x], x))
         })
     }
 }
