@@ -255,22 +255,36 @@ struct Neighbourhood {
     key: Vec<u64>,
 }
 
-impl Neighbourhood {
-    /// The neighbourhood of block slot `k`.
-    fn new(slot: &[Option<Ring>], k: usize, alive: &[bool], protected: usize) -> Self {
-        // the slots holding each cut, in slot order (as `neighbour_unions` searches them)
-        let mut holders: std::collections::HashMap<usize, Vec<usize>> =
-            std::collections::HashMap::new();
-        for (j, o) in slot.iter().enumerate() {
-            for t in o.iter().flat_map(|r| r.tags.iter()) {
-                if let Tag::Cut(c) = *t {
-                    let h = holders.entry(c).or_default();
-                    if h.last() != Some(&j) {
-                        h.push(j);
-                    }
+/// The slots holding each cut, in slot order (as `neighbour_unions` searches them): what
+/// [`Neighbourhood::new`] follows from a block to its neighbours. A function of the slots
+/// alone, so [`Builder::repair_pass`] computes it once per state of the slots.
+type CutHolders = std::collections::HashMap<usize, Vec<usize>>;
+
+/// The [`CutHolders`] of `slot`.
+fn cut_holders(slot: &[Option<Ring>]) -> CutHolders {
+    let mut holders = CutHolders::new();
+    for (j, o) in slot.iter().enumerate() {
+        for t in o.iter().flat_map(|r| r.tags.iter()) {
+            if let Tag::Cut(c) = *t {
+                let h = holders.entry(c).or_default();
+                if h.last() != Some(&j) {
+                    h.push(j);
                 }
             }
         }
+    }
+    holders
+}
+
+impl Neighbourhood {
+    /// The neighbourhood of block slot `k`; `holders` = [`cut_holders`]`(slot)`.
+    fn new(
+        slot: &[Option<Ring>],
+        holders: &CutHolders,
+        k: usize,
+        alive: &[bool],
+        protected: usize,
+    ) -> Self {
         let mut slots = vec![k];
         let mut frontier = vec![k];
         for _ in 0..2 {
@@ -1174,6 +1188,9 @@ impl Builder<'_> {
         // block, its neighbours and theirs (and the live cuts between them), so while those
         // are unchanged a later sweep would fail again on the same candidates
         let mut failed: Vec<Option<Neighbourhood>> = Vec::new();
+        // the cut holders of the current slots, recomputed after each change of the slots
+        // (a failed attempt changes nothing, and most attempts fail)
+        let mut holders: Option<CutHolders> = None;
         while budget > 0 {
             if k >= slot.len() {
                 if !changed {
@@ -1189,13 +1206,18 @@ impl Builder<'_> {
                 k += 1;
                 continue;
             }
-            let nb = Neighbourhood::new(&slot, k, &alive, self.protected_cuts);
+            let held = holders.get_or_insert_with(|| cut_holders(&slot));
+            let nb = Neighbourhood::new(&slot, held, k, &alive, self.protected_cuts);
             if failed.get(k).is_some_and(|f| f.as_ref() == Some(&nb)) {
                 k += 1;
                 continue;
             }
             budget -= 1;
-            match self.cached_attempt(&slot, k, &alive, &r, &nb) {
+            let attempt = self.cached_attempt(&slot, k, &alive, &r, &nb);
+            if !matches!(attempt, Attempt::Fail) {
+                holders = None;
+            }
+            match attempt {
                 // 1. split alone
                 Attempt::Split((_, a, b, ends)) => {
                     let (a, b, id) = self.commit_split(a, b, ends);
