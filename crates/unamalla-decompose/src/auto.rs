@@ -324,6 +324,30 @@ pub(crate) struct LayoutCache {
     pub repair: Mutex<RepairCache>,
     /// Algorithm 1 on a leaf piece, keyed by [`piece_key`].
     leaf_runs: Mutex<HashMap<Vec<u64>, Arc<LeafRun>>>,
+    /// The builder after applying each layout's cut list ([`AppliedCuts`]).
+    applied: Mutex<Vec<Arc<AppliedCuts>>>,
+}
+
+/// A [`Builder`] (of the cache's region and options) right after [`Builder::apply_cut`] of
+/// each cut of `layout` in order. The rebuilds of [`chord_layout_cuts`] extend the cut list
+/// of the layout before them, so they can start from its state and apply only the new cuts.
+/// Exact: applying a cut reads and changes only the builder's cuts, tree nodes and pieces,
+/// which start from the region alone, so the state after a list of cuts is a function of the
+/// region and that list (matched bit for bit, [`same_cuts`]).
+struct AppliedCuts {
+    layout: Vec<(DVec2, DVec2)>,
+    cuts: Vec<(DVec2, DVec2)>,
+    nodes: Vec<TreeNode>,
+    pieces: Vec<Option<Piece>>,
+}
+
+/// Whether two cut lists are the same, coordinates compared bit for bit.
+fn same_cuts(a: &[(DVec2, DVec2)], b: &[(DVec2, DVec2)]) -> bool {
+    let bits = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| bits(x.0) == bits(y.0) && bits(x.1) == bits(y.1))
 }
 
 /// The exact content of a piece (vertex bits, edge tags with their cut ids, per ring).
@@ -358,8 +382,35 @@ fn layout_from_cuts_cached(
     let tol = crate::decomposition::boundary_tol(region);
     let mut b = Builder::new(region, opts);
     b.cache = cache.cloned();
-    for &(p, q) in cuts {
+    // start from the state of the longest cut list applied before that begins this one
+    let start = cache
+        .and_then(|c| {
+            let applied = c.applied.lock().ok()?;
+            applied
+                .iter()
+                .filter(|a| a.layout.len() <= cuts.len())
+                .filter(|a| same_cuts(&a.layout, &cuts[..a.layout.len()]))
+                .max_by_key(|a| a.layout.len())
+                .cloned()
+        })
+        .map_or(0, |a| {
+            b.cuts.clone_from(&a.cuts);
+            b.nodes.clone_from(&a.nodes);
+            b.pieces.clone_from(&a.pieces);
+            a.layout.len()
+        });
+    for &(p, q) in &cuts[start..] {
         b.apply_cut(p, q, tol, Step::Chord);
+    }
+    if let Some(c) = cache.filter(|_| start < cuts.len()) {
+        if let Ok(mut applied) = c.applied.lock() {
+            applied.push(Arc::new(AppliedCuts {
+                layout: cuts.to_vec(),
+                cuts: b.cuts.clone(),
+                nodes: b.nodes.clone(),
+                pieces: b.pieces.clone(),
+            }));
+        }
     }
     b.protected_cuts = b.cuts.len();
     b.run_auto_on_leaves()?;
