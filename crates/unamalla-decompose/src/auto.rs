@@ -549,6 +549,21 @@ impl AngleScreen {
     }
 }
 
+/// Whether a candidate cut whose cheap terms are `pre` (and every later one: the candidates
+/// are sorted by `pre`) cannot beat the best score `best` so far.
+///
+/// Exact for the two-child score `s = ½·max(B₁, B₂) + ¼·(B₁ + B₂) + pre` (`B` a badness or a
+/// corner cost, never negative: the quad fit's corner score F is a sum of squares and ratios
+/// of lengths with its fixed non-negative weights, its fallback ½ + a mean of squares,
+/// `1 + κ₂ + κ₃` is at least 1 and a grade is 0, 1 or 3): the first two terms add up to some
+/// `X ≥ 0` (or
+/// NaN), and rounding is monotone, so `s = fl(X + pre) ≥ pre ≥ best` (or NaN): `s < best`,
+/// the test for a new best, fails. A later candidate has a `pre` at least as large (in the
+/// `total_cmp` order of the sort, only a NaN comes after, whose score is NaN).
+pub(crate) fn beyond_best(pre: f64, best: f64) -> bool {
+    pre >= best
+}
+
 impl<'a> Builder<'a> {
     pub fn new(region: &'a Region, opts: &'a DecomposeOptions) -> Self {
         let outer = Ring {
@@ -1255,6 +1270,10 @@ impl<'a> Builder<'a> {
             let mut evaluated = 0;
             for c in &cands {
                 if evaluated >= 60 {
+                    break;
+                }
+                // no later candidate can win (exact, see `beyond_best`)
+                if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
                     break;
                 }
                 if !piece.admissible(&idx, c.e1, c.e2) {

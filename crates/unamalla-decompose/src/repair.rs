@@ -53,10 +53,12 @@
 //!    than a less admissible block. [`Decomposition::cut_joints`](crate::Decomposition::cut_joints)
 //!    lists the joints that remain (none on the fixture regions, tested).
 
+use std::cell::Cell;
+
 use rayon::prelude::*;
 use unamalla_mesh::DVec2;
 
-use crate::auto::{needs_cut_point, triangle_plan, Builder};
+use crate::auto::{beyond_best, needs_cut_point, triangle_plan, Builder};
 use crate::concavity::{concavity, concavity_with_angles, critical_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
@@ -589,15 +591,25 @@ impl Builder<'_> {
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
         let need = if good_only { 2 } else { 0 };
-        self.for_each_split(ring, quarter_points, need, &mut |pre, a, b, ends| {
-            let (Some(fa), Some(fb)) = (accept(&a), accept(&b)) else {
-                return;
-            };
-            let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
-            if best.as_ref().is_none_or(|b| s < b.0) {
-                best = Some((s, a, b, ends));
-            }
-        });
+        // the best score so far: the search ends at the first candidate whose cheap terms
+        // reach it (exact, `beyond_best`: `accept` costs are never negative)
+        let bound = Cell::new(f64::NAN);
+        self.for_each_split(
+            ring,
+            quarter_points,
+            need,
+            Some(&bound),
+            &mut |pre, a, b, ends| {
+                // `accept` is pure: the second child is not looked at when the first fails
+                let Some(fa) = accept(&a) else { return };
+                let Some(fb) = accept(&b) else { return };
+                let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
+                if best.as_ref().is_none_or(|b| s < b.0) {
+                    bound.set(s);
+                    best = Some((s, a, b, ends));
+                }
+            },
+        );
         best
     }
 
@@ -611,11 +623,17 @@ impl Builder<'_> {
     /// children are good ([`Builder::good_fit`]): a counted candidate (it still counts towards
     /// the 80) whose children cannot be is not built or visited ([`ChildScreen`]), and when no
     /// candidate can pass, nothing is searched. `need` = 0 visits every counted candidate.
+    ///
+    /// With a `bound` (the caller's best two-child score so far, NaN while there is none),
+    /// the search ends at the first candidate whose `pre` reaches it: the caller keeps a
+    /// candidate only if it scores below the bound, which no candidate from there on can
+    /// (`beyond_best`).
     fn for_each_split(
         &self,
         ring: &Ring,
         quarter_points: bool,
         need: usize,
+        bound: Option<&Cell<f64>>,
         visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
     ) {
         let n = ring.len();
@@ -693,7 +711,7 @@ impl Builder<'_> {
         });
         let mut evaluated = 0;
         for (pre, e1, e2) in order.into_iter().map(|(_, k)| cands[k]) {
-            if evaluated >= 80 {
+            if evaluated >= 80 || bound.is_some_and(|b| beyond_best(pre, b.get())) {
                 break;
             }
             if !piece.admissible(&idx, e1, e2) {
@@ -736,9 +754,15 @@ impl Builder<'_> {
             let mut firsts = Vec::new();
             // a first cut is followed only if it leaves exactly one accepted child
             let need = if good_only { 1 } else { 0 };
-            self.for_each_split(ring, quarter_points, need, &mut |pre1, a, b, ends1| {
-                firsts.push((pre1, a, b, ends1));
-            });
+            self.for_each_split(
+                ring,
+                quarter_points,
+                need,
+                None,
+                &mut |pre1, a, b, ends1| {
+                    firsts.push((pre1, a, b, ends1));
+                },
+            );
             let found: Vec<Option<Resplit>> = firsts
                 .into_par_iter()
                 .map(|(pre1, a, b, ends1)| {
