@@ -27,10 +27,10 @@
 //! four cells meet at the tip.
 
 use serde::{Deserialize, Serialize};
-use unamalla_mesh::geometry::{convex_hull, point_segment_distance};
+use unamalla_mesh::geometry::point_segment_distance;
 use unamalla_mesh::DVec2;
 
-use crate::geom::{diameter, perimeter, ring_angle, ring_angles, signed_area};
+use crate::geom::{convex_hull, diameter, perimeter, ring_angle, ring_angles, signed_area};
 
 /// Tolerances of the concavity criteria and the critical angle (thesis Obs 4.8, §4.1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

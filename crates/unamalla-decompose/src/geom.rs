@@ -98,6 +98,69 @@ pub(crate) fn in_wedge(prev: DVec2, cur: DVec2, next: DVec2, x: DVec2) -> bool {
     }
 }
 
+/// [`unamalla_mesh::geometry::convex_hull`] (Andrew's monotone chain with the exact
+/// `orient2d`: counter-clockwise hull indices from the lowest-then-leftmost point, no
+/// collinear points, the lowest index of equal points), computed the same way with a
+/// faster sort.
+///
+/// The same result: that function sorts the indices stably by `x`, then `y` (each by
+/// `total_cmp`), so equal coordinates stay in index order; here the triples (`x` key, `y`
+/// key, index) are sorted, with keys that order as `total_cmp` does — the same sequence,
+/// without the indirect reads and the stable sort's buffer. The removal of equal points
+/// (`==`, as there), the two chains and the rotation are the same steps on the same values.
+pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<usize> {
+    // `f64::total_cmp`'s key (the bits with the magnitude flipped for negative numbers,
+    // compared as i64), shifted to compare as u64
+    let key = |v: f64| {
+        let b = v.to_bits() as i64;
+        ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
+    };
+    let mut keyed: Vec<(u64, u64, usize)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (key(p.x), key(p.y), i))
+        .collect();
+    keyed.sort_unstable();
+    let mut idx: Vec<usize> = Vec::with_capacity(keyed.len());
+    for &(_, _, i) in &keyed {
+        if idx.last().is_none_or(|&l| points[l] != points[i]) {
+            idx.push(i);
+        }
+    }
+    if idx.len() < 3 {
+        return idx;
+    }
+    let mut hull: Vec<usize> = Vec::with_capacity(idx.len() * 2);
+    for pass in 0..2 {
+        let start = hull.len();
+        for k in 0..idx.len() {
+            let i = if pass == 0 {
+                idx[k]
+            } else {
+                idx[idx.len() - 1 - k]
+            };
+            while hull.len() >= start + 2 {
+                let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+                if orient2d(points[a], points[b], points[i]) <= 0.0 {
+                    hull.pop();
+                } else {
+                    break;
+                }
+            }
+            hull.push(i);
+        }
+        hull.pop();
+    }
+    // rotate to start at the lowest-then-leftmost point
+    if let Some(k) = (0..hull.len()).min_by(|&a, &b| {
+        let (p, q) = (points[hull[a]], points[hull[b]]);
+        p.y.total_cmp(&q.y).then(p.x.total_cmp(&q.x))
+    }) {
+        hull.rotate_left(k);
+    }
+    hull
+}
+
 /// Shoelace signed area (positive for counter-clockwise rings).
 pub(crate) fn signed_area(ring: &[DVec2]) -> f64 {
     unamalla_mesh::region::signed_area(ring)
@@ -197,6 +260,52 @@ mod tests {
         assert!(in_wedge(next, o, prev, DVec2::new(-1.0, 1.0)));
         assert!((left_angle(prev, o, next) - PI / 2.0).abs() < 1e-12);
         assert!((left_angle(next, o, prev) - 1.5 * PI).abs() < 1e-12);
+    }
+
+    /// `convex_hull` returns what `unamalla_mesh::geometry::convex_hull` returns: on
+    /// pseudo-random point sets with repeated points, collinear runs, signed zeros and
+    /// coordinates of both signs.
+    #[test]
+    fn hull_matches_the_mesh_crates() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for case in 0..400 {
+            let n = 1 + (next() % 40) as usize;
+            let grid = 1 + (case % 7) as u64;
+            let mut pts: Vec<DVec2> = (0..n)
+                .map(|_| {
+                    let c = |r: u64| (r % (2 * grid + 1)) as f64 - grid as f64;
+                    DVec2::new(c(next()), c(next()))
+                })
+                .collect();
+            if case % 5 == 0 {
+                // signed zeros and exact repeats
+                pts.push(DVec2::new(-0.0, 0.0));
+                pts.push(DVec2::new(0.0, -0.0));
+                pts.push(pts[0]);
+            }
+            if case % 4 == 1 {
+                // general positions
+                pts.extend((0..50).map(|_| {
+                    let c = |r: u64| (r as f64 / u64::MAX as f64 - 0.5) * 1e3;
+                    DVec2::new(c(next()), c(next()))
+                }));
+            }
+            if case % 3 == 0 {
+                // a collinear run
+                pts.extend((0..5).map(|k| DVec2::new(k as f64 * 0.5, 1.0 + k as f64 * 0.25)));
+            }
+            assert_eq!(
+                convex_hull(&pts),
+                unamalla_mesh::geometry::convex_hull(&pts),
+                "{pts:?}"
+            );
+        }
     }
 
     #[test]
