@@ -863,13 +863,18 @@ impl Builder<'_> {
     ) -> Option<Merge> {
         let mut best: Option<Merge> = None;
         let r = slot[k].as_ref()?;
-        for (j, c, u) in self.neighbour_unions(slot, r, &[k], alive) {
-            let option = match accept(&u) {
+        let unions = self.neighbour_unions(slot, r, &[k], alive);
+        // the unions are searched in parallel and compared in order (the searches are pure)
+        let options: Vec<Option<(f64, Option<Split>)>> = unions
+            .par_iter()
+            .map(|(_, _, u)| match accept(u) {
                 Some(cost) => Some((cost, None)),
                 None => self
-                    .best_split_by(&u, accept, good_only)
+                    .best_split_by(u, accept, good_only)
                     .map(|s| (s.0, Some(s))),
-            };
+            })
+            .collect();
+        for ((j, c, u), option) in unions.into_iter().zip(options) {
             if let Some((s, split)) = option {
                 if beats(
                     s,
@@ -951,51 +956,66 @@ impl Builder<'_> {
             }
             hosts.push((Host::Merged { j, c }, u));
         }
-        hosts.append(&mut hosts2);
         let memo = FitMemo::default();
-        // corner scores of the good blocks among the hosts' blocks, each computed once
-        let mut fits: Vec<(usize, Option<f64>)> = Vec::new();
-        let mut best: Option<(Host, Resplit)> = None;
-        for (host, u) in hosts {
-            // the fewest blocks disturbed: two neighbours only when no re-split of the block
-            // alone or with one neighbour works
-            if matches!(host, Host::Merged2 { .. }) && best.is_some() {
-                break;
-            }
+        // the candidates of one host, in the order the search yields them: the split of a
+        // union with two neighbours by one cut, then the split by two cuts
+        let candidates = |(host, u): &(Host, Ring)| -> Vec<Resplit> {
             // a good neighbour may not come out with a worse corner score than RESPLIT_SLACK
             // above the worst good block it replaces (gulf-of-mexico: the repair of a small
             // block re-cornered the 39-vertex central basin, F 0.13 → 0.20, whose transfinite
             // grid then folded over more area than it covered)
-            let mut limit = f64::NEG_INFINITY;
-            for s in host.parts(k).0 {
-                let f = match fits.iter().find(|f| f.0 == s) {
-                    Some(&(_, f)) => f,
-                    None => {
-                        let f = slot[s].as_ref().and_then(|r| self.good_fit(r));
-                        fits.push((s, f));
-                        f
-                    }
-                };
-                if let Some(f) = f {
-                    limit = limit.max(f + RESPLIT_SLACK);
-                }
-            }
-            if limit == f64::NEG_INFINITY {
-                limit = f64::INFINITY;
-            }
+            let limit = host
+                .parts(k)
+                .0
+                .iter()
+                .filter_map(|&s| slot[s].as_ref().and_then(|r| memo.good_fit(self, r)))
+                .map(|f| f + RESPLIT_SLACK)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let limit = if limit == f64::NEG_INFINITY {
+                f64::INFINITY
+            } else {
+                limit
+            };
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
             let two = matches!(host, Host::Merged2 { .. })
-                .then(|| self.best_split_by(&u, &good, true))
+                .then(|| self.best_split_by(u, &good, true))
                 .flatten()
                 .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
-            for s in two.into_iter().chain(self.best_split3(&u, &good, true)) {
+            two.into_iter()
+                .chain(self.best_split3(u, &good, true))
+                .collect()
+        };
+        // the lowest score wins, candidates compared in host order (as a sequential loop
+        // over the hosts would: the searches are pure, the memo only saves work)
+        let fold = |best: &mut Option<(Host, Resplit)>, host: Host, found: Vec<Resplit>| {
+            for s in found {
                 if beats(
                     s.0,
                     ring_key(&s.1[0]),
                     best.as_ref().map(|(_, b)| (b.0, ring_key(&b.1[0]))),
                 ) {
-                    best = Some((host, s));
+                    *best = Some((host, s));
                 }
+            }
+        };
+        let mut best: Option<(Host, Resplit)> = None;
+        let found: Vec<Vec<Resplit>> = hosts.par_iter().map(candidates).collect();
+        for ((host, _), f) in hosts.iter().zip(found) {
+            fold(&mut best, *host, f);
+        }
+        // the fewest blocks disturbed: two neighbours only when no re-split of the block
+        // alone or with one neighbour works, and only up to the first of those that works
+        // (searched a few at a time in parallel: a later one would be searched in vain)
+        for chunk in hosts2.chunks(rayon::current_num_threads().max(1)) {
+            if best.is_some() {
+                break;
+            }
+            let found: Vec<Vec<Resplit>> = chunk.par_iter().map(candidates).collect();
+            for ((host, _), f) in chunk.iter().zip(found) {
+                if best.is_some() {
+                    break;
+                }
+                fold(&mut best, *host, f);
             }
         }
         best
