@@ -9,15 +9,15 @@ use rayon::prelude::*;
 
 use unamalla_mesh::{DVec2, Region};
 
-use crate::concavity::{concavity, concavity_with_angles, Tolerances};
+use crate::concavity::{concavity, concavity_with_hull, Tolerances};
 use crate::corners::{
     quad_fit, quad_fit_with_angles, select_corners, triangle_rule, CornerWeights, TriangleBlock,
 };
 use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::geom::{
-    angle_penalty, left_angle, perimeter, project_t, ray_segment, ring_angle, ring_angles,
-    ring_angles_from,
+    angle_penalty, child_hull, convex_hull, convex_hull_distinct, left_angle, match_vertices,
+    perimeter, project_t, ray_segment, ring_angle, ring_angles, ring_angles_matched,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -1181,10 +1181,11 @@ impl<'a> Builder<'a> {
 
     /// Badness B(P) of a hole-free piece: its corner score F* if it is approximately convex
     /// (it will be a block), else 1 + κ₂ + κ₃ (it will be cut again).
-    /// The ring's vertex angles are given (`angles[i]` = `ring_angle(ring, i)`), for the
-    /// concavity measures and the corner score.
-    fn badness_with_angles(&self, ring: &[DVec2], angles: &[f64]) -> f64 {
-        let c = concavity_with_angles(ring, angles);
+    /// The ring's vertex angles (`angles[i]` = `ring_angle(ring, i)`) and convex hull (as
+    /// [`concavity_with_hull`] takes it) are given, for the concavity measures and the corner
+    /// score.
+    fn badness_with_hull(&self, ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> f64 {
+        let c = concavity_with_hull(ring, angles, hull);
         if c.approximately_convex(&self.opts.tolerances) {
             quad_fit_with_angles(ring, angles)
         } else {
@@ -1197,7 +1198,8 @@ impl<'a> Builder<'a> {
         let ring = &piece.outer;
         let n = ring.len();
         let angle: Vec<f64> = ring_angles(&ring.pts);
-        let conc = concavity_with_angles(&ring.pts, &angle);
+        let (hull, distinct) = convex_hull_distinct(&ring.pts);
+        let conc = concavity_with_hull(&ring.pts, &angle, hull.clone());
         let area = piece.area();
         let sq = area.sqrt();
         let mut starts: Vec<usize> = (0..n)
@@ -1294,7 +1296,7 @@ impl<'a> Builder<'a> {
                 }
                 evaluated += 1;
                 // the children's vertex angles from the piece's where a vertex keeps its
-                // neighbours (exact, `ring_angles_from`): `a` starts at the cut's first end
+                // neighbours (exact, `ring_angles_matched`): `a` starts at the cut's first end
                 // (vertex `i` of the piece), `b` at its second end (a vertex, or a point inside
                 // an edge followed by the edge's end)
                 let start_b = match c.e2.pos {
@@ -1305,14 +1307,19 @@ impl<'a> Builder<'a> {
                     Pos::Vertex(i) => i,
                     Pos::OnEdge(e, _) => e + 1,
                 };
-                let ba = self.badness_with_angles(
-                    &a.outer.pts,
-                    &ring_angles_from(&a.outer.pts, &ring.pts, &angle, start_a),
-                );
-                let bb = self.badness_with_angles(
-                    &b.outer.pts,
-                    &ring_angles_from(&b.outer.pts, &ring.pts, &angle, start_b),
-                );
+                // and their convex hulls from the piece's where that is certain (exact,
+                // `child_hull`: mostly the child that keeps the piece's hull vertices)
+                let badness = |child: &[DVec2], start: usize| {
+                    let map = match_vertices(child, &ring.pts, start);
+                    let angles = ring_angles_matched(child, &ring.pts, &angle, &map);
+                    let hull = distinct
+                        .then(|| child_hull(&ring.pts, &hull, child, &map))
+                        .flatten()
+                        .unwrap_or_else(|| convex_hull(child));
+                    self.badness_with_hull(child, &angles, hull)
+                };
+                let ba = badness(&a.outer.pts, start_a);
+                let bb = badness(&b.outer.pts, start_b);
                 let s = 0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre;
                 if best.as_ref().is_none_or(|b| s < b.0) {
                     best = Some((s, *c));

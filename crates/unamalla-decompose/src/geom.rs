@@ -33,30 +33,19 @@ pub(crate) fn ring_angles(ring: &[DVec2]) -> Vec<f64> {
     (0..ring.len()).map(|i| ring_angle(ring, i)).collect()
 }
 
-/// [`ring_angles`] of `ring`, taken from `src_angles` (the [`ring_angles`] of `src`) at every
-/// vertex whose predecessor, point and successor are bit for bit those of a vertex of `src`
-/// (then `ring_angle` would repeat the same computation on the same numbers) and computed
-/// elsewhere. `ring` is expected to follow `src` from index `start` on, with points inserted
-/// or left out (a child of a split); the match of each vertex is checked, so any `start`
-/// gives the exact result, a good one just finds more matches.
-pub(crate) fn ring_angles_from(
-    ring: &[DVec2],
-    src: &[DVec2],
-    src_angles: &[f64],
-    start: usize,
-) -> Vec<f64> {
-    let (n, m) = (ring.len(), src.len());
-    if m == 0 || src_angles.len() != m {
-        return ring_angles(ring);
+/// For each vertex of `ring` (expected to follow `src` from index `start` on, with points
+/// inserted or left out: a child of a split), the index of the vertex of `src` it matches —
+/// walking both in order, a vertex matches the next `src` vertex when their coordinates are
+/// the same bit for bit — or `usize::MAX`.
+pub(crate) fn match_vertices(ring: &[DVec2], src: &[DVec2], start: usize) -> Vec<usize> {
+    let m = src.len();
+    if m == 0 {
+        return vec![usize::MAX; ring.len()];
     }
-    let same =
-        |a: DVec2, b: DVec2| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits();
-    // the vertex of `src` matching each vertex of `ring` (`usize::MAX`: none)
     let mut s = start % m;
-    let map: Vec<usize> = ring
-        .iter()
+    ring.iter()
         .map(|&p| {
-            if same(src[s], p) {
+            if same_point(src[s], p) {
                 let k = s;
                 s = (s + 1) % m;
                 k
@@ -64,13 +53,36 @@ pub(crate) fn ring_angles_from(
                 usize::MAX
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Whether two points have the same coordinates bit for bit.
+fn same_point(a: DVec2, b: DVec2) -> bool {
+    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
+}
+
+/// [`ring_angles`] of `ring`, taken from `src_angles` (the [`ring_angles`] of `src`) at every
+/// vertex whose predecessor, point and successor are bit for bit those of a vertex of `src`
+/// (then `ring_angle` would repeat the same computation on the same numbers) and computed
+/// elsewhere. `map` is the match of `ring`'s vertices in `src` ([`match_vertices`]); each
+/// vertex's neighbours are checked, so any match gives the exact result, a good one (a
+/// child of a split, matched from where it starts in `src`) just reuses more angles.
+pub(crate) fn ring_angles_matched(
+    ring: &[DVec2],
+    src: &[DVec2],
+    src_angles: &[f64],
+    map: &[usize],
+) -> Vec<f64> {
+    let (n, m) = (ring.len(), src.len());
+    if m == 0 || src_angles.len() != m {
+        return ring_angles(ring);
+    }
     (0..n)
         .map(|k| {
             let j = map[k];
             let reuse = j != usize::MAX
-                && same(src[(j + m - 1) % m], ring[(k + n - 1) % n])
-                && same(src[(j + 1) % m], ring[(k + 1) % n]);
+                && same_point(src[(j + m - 1) % m], ring[(k + n - 1) % n])
+                && same_point(src[(j + 1) % m], ring[(k + 1) % n]);
             if reuse {
                 src_angles[j]
             } else {
@@ -109,6 +121,11 @@ pub(crate) fn in_wedge(prev: DVec2, cur: DVec2, next: DVec2, x: DVec2) -> bool {
 /// without the indirect reads and the stable sort's buffer. The removal of equal points
 /// (`==`, as there), the two chains and the rotation are the same steps on the same values.
 pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<usize> {
+    convex_hull_distinct(points).0
+}
+
+/// [`convex_hull`], and whether the points are pairwise different (`!=`).
+pub(crate) fn convex_hull_distinct(points: &[DVec2]) -> (Vec<usize>, bool) {
     // `f64::total_cmp`'s key (the bits with the magnitude flipped for negative numbers,
     // compared as i64), shifted to compare as u64
     let key = |v: f64| {
@@ -127,8 +144,9 @@ pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<usize> {
             idx.push(i);
         }
     }
+    let distinct = idx.len() == points.len();
     if idx.len() < 3 {
-        return idx;
+        return (idx, distinct);
     }
     let mut hull: Vec<usize> = Vec::with_capacity(idx.len() * 2);
     for pass in 0..2 {
@@ -158,7 +176,54 @@ pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<usize> {
     }) {
         hull.rotate_left(k);
     }
-    hull
+    (hull, distinct)
+}
+
+/// The [`convex_hull`] of `child` (up to where its cycle starts), from the hull `parent_hull`
+/// of `parent`, where that is certain: `parent`'s points are pairwise different (`!=`),
+/// `map` (from [`match_vertices`]) finds every parent hull vertex among `child`'s vertices,
+/// and every other point of `child` (one not matched to `parent`) lies inside or on the
+/// hull (exact `orient2d`) without being a hull vertex. `None` otherwise.
+///
+/// Why: the child's points are parent points (inside or on the parent hull) and points
+/// inside or on it, among them all the parent hull's vertices, so the child's hull is the
+/// parent's; its strict vertices are the same points, each one exactly once among the
+/// child's points, so `convex_hull(child)` lists them — counter-clockwise, as the parent
+/// hull does — by their child indices.
+pub(crate) fn child_hull(
+    parent: &[DVec2],
+    parent_hull: &[usize],
+    child: &[DVec2],
+    map: &[usize],
+) -> Option<Vec<usize>> {
+    let h = parent_hull.len();
+    if h < 3 || child.len() < h {
+        return None;
+    }
+    // the child index of each parent vertex
+    let mut at = vec![usize::MAX; parent.len()];
+    for (k, &j) in map.iter().enumerate() {
+        if j != usize::MAX {
+            if at[j] != usize::MAX {
+                return None;
+            }
+            at[j] = k;
+        }
+    }
+    let hull: Vec<usize> = parent_hull.iter().map(|&j| at[j]).collect();
+    if hull.contains(&usize::MAX) {
+        return None;
+    }
+    let inside = |p: DVec2| {
+        (0..h).all(|i| {
+            let (a, b) = (parent[parent_hull[i]], parent[parent_hull[(i + 1) % h]]);
+            p != a && orient2d(a, b, p) >= 0.0
+        })
+    };
+    map.iter()
+        .zip(child)
+        .all(|(&j, &p)| j != usize::MAX || inside(p))
+        .then_some(hull)
 }
 
 /// Shoelace signed area (positive for counter-clockwise rings).
@@ -306,6 +371,63 @@ mod tests {
                 "{pts:?}"
             );
         }
+    }
+
+    /// Where `child_hull` answers, its hull is `convex_hull` of the child up to rotation:
+    /// children of pseudo-random star-shaped rings cut between two vertices, or from a vertex
+    /// to a point inserted inside an edge.
+    #[test]
+    fn child_hulls_match_the_computed_ones() {
+        let mut state = 0x1234_5678_9abc_def1u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let rotated = |h: &[usize]| {
+            let k = (0..h.len()).min_by_key(|&k| h[k]).unwrap_or(0);
+            let mut h = h.to_vec();
+            h.rotate_left(k);
+            h
+        };
+        let mut derived = 0;
+        for _ in 0..2000 {
+            let n = 5 + (next() * 40.0) as usize;
+            let ring: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * (i as f64 + 0.5 * next()) / n as f64;
+                    let r = 0.5 + next();
+                    DVec2::new(r * t.cos(), r * t.sin())
+                })
+                .collect();
+            let (hull, distinct) = convex_hull_distinct(&ring);
+            assert!(distinct);
+            let i = (next() * n as f64) as usize % n;
+            // a child of any size, or one that leaves out a few vertices only (which keeps
+            // the hull more often)
+            let len = if next() < 0.5 {
+                3 + (next() * (n - 3) as f64) as usize
+            } else {
+                n - 1 - (next() * 3.0) as usize
+            };
+            let mut child: Vec<DVec2> = (0..len).map(|k| ring[(i + k) % n]).collect();
+            let extra = next();
+            if extra < 0.4 {
+                // the cut ends inside the edge after the child's last vertex
+                let (a, b) = (ring[(i + len - 1) % n], ring[(i + len) % n]);
+                child.push(a + next() * (b - a));
+            } else if extra < 0.6 {
+                // a point anywhere (inside or outside the ring's hull)
+                child.push(DVec2::new(3.0 * next() - 1.5, 3.0 * next() - 1.5));
+            }
+            let map = match_vertices(&child, &ring, i);
+            if let Some(h) = child_hull(&ring, &hull, &child, &map) {
+                derived += 1;
+                assert_eq!(rotated(&h), rotated(&convex_hull(&child)), "{child:?}");
+            }
+        }
+        assert!(derived > 100, "{derived}");
     }
 
     #[test]
