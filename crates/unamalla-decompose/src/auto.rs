@@ -17,7 +17,7 @@ use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::geom::{
     angle_penalty, child_hull, convex_hull, convex_hull_distinct, left_angle, match_vertices,
-    perimeter, project_t, ray_segment, ring_angle, ring_angles, ring_angles_matched,
+    perimeter, project_t, ray_segment, ring_angle, ring_angles, ring_angles_matched, visit_sorted,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -1262,24 +1262,33 @@ impl<'a> Builder<'a> {
                     });
                 }
             }
-            cands.sort_by(|a, b| {
-                a.pre.total_cmp(&b.pre).then_with(|| {
-                    let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
-                    pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
-                })
-            });
+            // the candidates in the order of (pre, coordinates of the second end, position):
+            // the sequence a stable sort by pre and coordinates gives, sorted only as far as
+            // the search goes (`visit_sorted`)
+            let mut order: Vec<usize> = (0..cands.len()).collect();
+            let cmp = |&ka: &usize, &kb: &usize| {
+                let (a, b) = (&cands[ka], &cands[kb]);
+                a.pre
+                    .total_cmp(&b.pre)
+                    .then_with(|| {
+                        let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
+                        pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
+                    })
+                    .then(ka.cmp(&kb))
+            };
             let mut best: Option<(f64, Cand)> = None;
             let mut evaluated = 0;
-            for c in &cands {
+            visit_sorted(&mut order, cmp, |&k| {
+                let c = &cands[k];
                 if evaluated >= 60 {
-                    break;
+                    return false;
                 }
                 // no later candidate can win (exact, see `beyond_best`)
                 if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
-                    break;
+                    return false;
                 }
                 if !piece.admissible(&idx, c.e1, c.e2) {
-                    continue;
+                    return true;
                 }
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);
@@ -1292,7 +1301,7 @@ impl<'a> Builder<'a> {
                     self.min_area
                 };
                 if aa < min_area || ab < min_area {
-                    continue;
+                    return true;
                 }
                 evaluated += 1;
                 // the children's vertex angles from the piece's where a vertex keeps its
@@ -1324,7 +1333,8 @@ impl<'a> Builder<'a> {
                 if best.as_ref().is_none_or(|b| s < b.0) {
                     best = Some((s, *c));
                 }
-            }
+                true
+            });
             if let Some((_, c)) = best {
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);

@@ -226,6 +226,34 @@ pub(crate) fn child_hull(
         .then_some(hull)
 }
 
+/// Calls `visit` on the elements of `items` in ascending `cmp` order until it returns
+/// `false`, sorting only as far as the visits go: the next chunk of smallest elements is
+/// found by selection and sorted (chunks of 64, then doubling). `cmp` must be a strict total
+/// order (no two elements equal), so the sequence is the one a full sort would give.
+pub(crate) fn visit_sorted<T>(
+    items: &mut [T],
+    cmp: impl Fn(&T, &T) -> std::cmp::Ordering,
+    mut visit: impl FnMut(&T) -> bool,
+) {
+    let (mut start, mut chunk) = (0, 64);
+    while start < items.len() {
+        let rest = &mut items[start..];
+        let c = chunk.min(rest.len());
+        if c < rest.len() {
+            // the c smallest first, in some order
+            rest.select_nth_unstable_by(c - 1, &cmp);
+        }
+        rest[..c].sort_unstable_by(&cmp);
+        for x in &rest[..c] {
+            if !visit(x) {
+                return;
+            }
+        }
+        start += c;
+        chunk *= 2;
+    }
+}
+
 /// Shoelace signed area (positive for counter-clockwise rings).
 pub(crate) fn signed_area(ring: &[DVec2]) -> f64 {
     unamalla_mesh::region::signed_area(ring)
@@ -428,6 +456,37 @@ mod tests {
             }
         }
         assert!(derived > 100, "{derived}");
+    }
+
+    /// `visit_sorted` visits in the order of a full sort and stops when told.
+    #[test]
+    fn sorted_visits_follow_the_full_sort() {
+        let mut state = 7u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for n in [0, 1, 5, 63, 64, 65, 200, 1000] {
+            let items: Vec<(u64, usize)> = (0..n).map(|k| (next() % 50, k)).collect();
+            let mut sorted = items.clone();
+            sorted.sort();
+            for stop in [0, 1, 64, 100, usize::MAX] {
+                let mut seen = Vec::new();
+                let mut work = items.clone();
+                visit_sorted(
+                    &mut work,
+                    |a, b| a.cmp(b),
+                    |&x| {
+                        seen.push(x);
+                        seen.len() < stop
+                    },
+                );
+                let expect = &sorted[..sorted.len().min(stop.max(1))];
+                assert_eq!(&seen[..], expect, "n {n} stop {stop}");
+            }
+        }
     }
 
     #[test]

@@ -63,7 +63,7 @@ use crate::concavity::{concavity, concavity_with_angles, critical_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
-use crate::geom::ring_angles;
+use crate::geom::{ring_angles, visit_sorted};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
@@ -695,40 +695,45 @@ impl Builder<'_> {
                 cands.push((w.angle * pen + w.length * p.distance(q) / sq, e1, e2));
             }
         }
-        // a stable sort of (pre, position) pairs by the candidates' order: the same sequence
-        // as a stable sort of the candidates themselves, with less to move
+        // the candidates in the order of (pre, coordinates of both ends, position): the
+        // sequence a stable sort by pre and coordinates gives, sorted only as far as the
+        // search goes (`visit_sorted`)
         let mut order: Vec<(f64, usize)> = (0..cands.len()).map(|k| (cands[k].0, k)).collect();
-        order.sort_by(|&(sa, ka), &(sb, kb)| {
-            sa.total_cmp(&sb).then_with(|| {
-                let (a, b) = (&cands[ka], &cands[kb]);
-                let (pa, pb) = (piece.point(a.1), piece.point(b.1));
-                let (qa, qb) = (piece.point(a.2), piece.point(b.2));
-                pa.x.total_cmp(&pb.x)
-                    .then(pa.y.total_cmp(&pb.y))
-                    .then(qa.x.total_cmp(&qb.x))
-                    .then(qa.y.total_cmp(&qb.y))
-            })
-        });
         let mut evaluated = 0;
-        for (pre, e1, e2) in order.into_iter().map(|(_, k)| cands[k]) {
+        let cmp = |&(sa, ka): &(f64, usize), &(sb, kb): &(f64, usize)| {
+            sa.total_cmp(&sb)
+                .then_with(|| {
+                    let (a, b) = (&cands[ka], &cands[kb]);
+                    let (pa, pb) = (piece.point(a.1), piece.point(b.1));
+                    let (qa, qb) = (piece.point(a.2), piece.point(b.2));
+                    pa.x.total_cmp(&pb.x)
+                        .then(pa.y.total_cmp(&pb.y))
+                        .then(qa.x.total_cmp(&qb.x))
+                        .then(qa.y.total_cmp(&qb.y))
+                })
+                .then(ka.cmp(&kb))
+        };
+        visit_sorted(&mut order, cmp, |&(_, k)| {
+            let (pre, e1, e2) = cands[k];
             if evaluated >= 80 || bound.is_some_and(|b| beyond_best(pre, b.get())) {
-                break;
+                return false;
             }
             if !piece.admissible(&idx, e1, e2) {
-                continue;
+                return true;
             }
             evaluated += 1;
             if screen
                 .as_ref()
                 .is_some_and(|c| c.possibly_good(e1, e2) < need)
             {
-                continue;
+                return true;
             }
             let mut m = piece.clone();
             let (x, y) = m.insert_ends(e1, e2);
             let (a, b) = m.split(x, y, TMP_CUT);
             visit(pre, a.outer, b.outer, (m.outer.p(x), m.outer.p(y)));
-        }
+            true
+        });
     }
 
     /// The best split of `ring` by **two** cuts into three blocks that `accept` takes (step 3
