@@ -16,8 +16,9 @@ use crate::corners::{
 use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::geom::{
-    angle_penalty, child_hull, convex_hull, convex_hull_distinct, left_angle, match_vertices,
-    perimeter, project_t, ray_segment, ring_angle, ring_angles, ring_angles_matched, visit_sorted,
+    angle_penalty, child_hull, child_hull_order, convex_hull, hull_from_order, hull_order,
+    left_angle, match_vertices, perimeter, project_t, ray_segment, ring_angle, ring_angles,
+    ring_angles_matched, visit_sorted,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -1198,7 +1199,8 @@ impl<'a> Builder<'a> {
         let ring = &piece.outer;
         let n = ring.len();
         let angle: Vec<f64> = ring_angles(&ring.pts);
-        let (hull, distinct) = convex_hull_distinct(&ring.pts);
+        let hull_keys = hull_order(&ring.pts);
+        let (hull, distinct) = hull_from_order(&ring.pts, &hull_keys);
         let conc = concavity_with_hull(&ring.pts, &angle, hull.clone());
         let area = piece.area();
         let sq = area.sqrt();
@@ -1316,14 +1318,22 @@ impl<'a> Builder<'a> {
                     Pos::Vertex(i) => i,
                     Pos::OnEdge(e, _) => e + 1,
                 };
-                // and their convex hulls from the piece's where that is certain (exact,
-                // `child_hull`: mostly the child that keeps the piece's hull vertices)
+                // and their convex hulls from the piece's: the piece's hull where the child
+                // keeps its vertices (`child_hull`), else from the piece's sorted points for a
+                // large child (`child_hull_order`; both exact, for pairwise different points)
                 let badness = |child: &[DVec2], start: usize| {
                     let map = match_vertices(child, &ring.pts, start);
                     let angles = ring_angles_matched(child, &ring.pts, &angle, &map);
+                    let large = 8 * child.len() >= n;
                     let hull = distinct
                         .then(|| child_hull(&ring.pts, &hull, child, &map))
                         .flatten()
+                        .or_else(|| {
+                            let keys = (distinct && large)
+                                .then(|| child_hull_order(&hull_keys, n, child, &map))
+                                .flatten()?;
+                            Some(hull_from_order(child, &keys).0)
+                        })
                         .unwrap_or_else(|| convex_hull(child));
                     self.badness_with_hull(child, &angles, hull)
                 };

@@ -124,22 +124,39 @@ pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<usize> {
     convex_hull_distinct(points).0
 }
 
-/// [`convex_hull`], and whether the points are pairwise different (`!=`).
-pub(crate) fn convex_hull_distinct(points: &[DVec2]) -> (Vec<usize>, bool) {
-    // `f64::total_cmp`'s key (the bits with the magnitude flipped for negative numbers,
-    // compared as i64), shifted to compare as u64
-    let key = |v: f64| {
-        let b = v.to_bits() as i64;
-        ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
-    };
-    let mut keyed: Vec<(u64, u64, usize)> = points
+/// A point's place in the sort of [`convex_hull`]: the keys of its `x` and `y` (ordering as
+/// `f64::total_cmp` does) and its index.
+pub(crate) type HullKey = (u64, u64, usize);
+
+/// The key of `v` that orders as `f64::total_cmp` (the bits with the magnitude flipped for
+/// negative numbers, compared as i64), shifted to compare as u64.
+fn total_key(v: f64) -> u64 {
+    let b = v.to_bits() as i64;
+    ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
+}
+
+/// The [`HullKey`]s of `points` in ascending order: the order in which the mesh crate's
+/// stable sort (by `x`, then `y`, equal points in index order) leaves them.
+pub(crate) fn hull_order(points: &[DVec2]) -> Vec<HullKey> {
+    let mut keyed: Vec<HullKey> = points
         .iter()
         .enumerate()
-        .map(|(i, p)| (key(p.x), key(p.y), i))
+        .map(|(i, p)| (total_key(p.x), total_key(p.y), i))
         .collect();
     keyed.sort_unstable();
-    let mut idx: Vec<usize> = Vec::with_capacity(keyed.len());
-    for &(_, _, i) in &keyed {
+    keyed
+}
+
+/// [`convex_hull`], and whether the points are pairwise different (`!=`).
+pub(crate) fn convex_hull_distinct(points: &[DVec2]) -> (Vec<usize>, bool) {
+    hull_from_order(points, &hull_order(points))
+}
+
+/// [`convex_hull_distinct`] from the points' [`hull_order`]: the removal of equal points,
+/// the two chains and the rotation of the mesh crate's function.
+pub(crate) fn hull_from_order(points: &[DVec2], order: &[HullKey]) -> (Vec<usize>, bool) {
+    let mut idx: Vec<usize> = Vec::with_capacity(order.len());
+    for &(_, _, i) in order {
         if idx.last().is_none_or(|&l| points[l] != points[i]) {
             idx.push(i);
         }
@@ -177,6 +194,55 @@ pub(crate) fn convex_hull_distinct(points: &[DVec2]) -> (Vec<usize>, bool) {
         hull.rotate_left(k);
     }
     (hull, distinct)
+}
+
+/// The [`hull_order`] of `child` from the hull order `parent_order` of `parent` (whose
+/// `parent_len` points must be pairwise different), with `map` from [`match_vertices`]: the
+/// matched vertices in the parent's order, under their child indices, merged with the other
+/// child points in theirs. `None` if `map` matches a parent vertex twice.
+///
+/// The same sequence in O(parent + child) instead of a sort: a matched vertex has its parent
+/// vertex's coordinates bit for bit, so its keys; the parent's keys are all different, so
+/// the parent's order is the order of the matched vertices' keys whatever their indices, and
+/// merging with the sorted others on whole keys gives the ascending order of all of them.
+pub(crate) fn child_hull_order(
+    parent_order: &[HullKey],
+    parent_len: usize,
+    child: &[DVec2],
+    map: &[usize],
+) -> Option<Vec<HullKey>> {
+    // the child index of each parent vertex
+    let mut at = vec![usize::MAX; parent_len];
+    for (k, &j) in map.iter().enumerate() {
+        if j != usize::MAX {
+            if at[j] != usize::MAX {
+                return None;
+            }
+            at[j] = k;
+        }
+    }
+    let mut others: Vec<HullKey> = map
+        .iter()
+        .zip(child)
+        .enumerate()
+        .filter(|(_, (&j, _))| j == usize::MAX)
+        .map(|(k, (_, p))| (total_key(p.x), total_key(p.y), k))
+        .collect();
+    others.sort_unstable();
+    let mut others = others.into_iter().peekable();
+    let mut out = Vec::with_capacity(child.len());
+    for &(kx, ky, j) in parent_order {
+        if at[j] == usize::MAX {
+            continue;
+        }
+        let item = (kx, ky, at[j]);
+        while let Some(o) = others.next_if(|&o| o < item) {
+            out.push(o);
+        }
+        out.push(item);
+    }
+    out.extend(others);
+    Some(out)
 }
 
 /// The [`convex_hull`] of `child` (up to where its cycle starts), from the hull `parent_hull`
@@ -456,6 +522,48 @@ mod tests {
             }
         }
         assert!(derived > 100, "{derived}");
+    }
+
+    /// `child_hull_order` gives the hull order a sort of the child gives, so the same hull.
+    #[test]
+    fn child_hull_orders_match_the_sorted_ones() {
+        let mut state = 0x0ddb_a11_5eed_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..1000 {
+            let n = 5 + (next() * 40.0) as usize;
+            let ring: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * (i as f64 + 0.5 * next()) / n as f64;
+                    let r = 0.5 + next();
+                    DVec2::new(r * t.cos(), r * t.sin())
+                })
+                .collect();
+            let order = hull_order(&ring);
+            let i = (next() * n as f64) as usize % n;
+            let len = 3 + (next() * (n - 3) as f64) as usize;
+            let mut child: Vec<DVec2> = (0..len).map(|k| ring[(i + k) % n]).collect();
+            if next() < 0.5 {
+                let (a, b) = (ring[(i + len - 1) % n], ring[(i + len) % n]);
+                child.push(a + next() * (b - a));
+            }
+            if next() < 0.3 {
+                // a copy of a vertex, and a point anywhere
+                child.insert(1, ring[(i + len / 2) % n]);
+                child.push(DVec2::new(3.0 * next() - 1.5, 3.0 * next() - 1.5));
+            }
+            let map = match_vertices(&child, &ring, i);
+            let derived = child_hull_order(&order, n, &child, &map).expect("a match");
+            assert_eq!(derived, hull_order(&child));
+            assert_eq!(
+                hull_from_order(&child, &derived),
+                convex_hull_distinct(&child)
+            );
+        }
     }
 
     /// `visit_sorted` visits in the order of a full sort and stops when told.
