@@ -9,15 +9,16 @@ use rayon::prelude::*;
 
 use unamalla_mesh::{DVec2, Region};
 
-use crate::concavity::{concavity, concavity_with_angles, Tolerances};
+use crate::concavity::{concavity, concavity_with_hull, Tolerances};
 use crate::corners::{
     quad_fit, quad_fit_with_angles, select_corners, triangle_rule, CornerWeights, TriangleBlock,
 };
 use crate::decomposition::{Block, Cut, Decomposition, EdgeKind, Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::geom::{
-    angle_penalty, left_angle, perimeter, project_t, ray_segment, ring_angle, ring_angles,
-    ring_angles_from,
+    angle_penalty, child_hull, child_hull_order, convex_hull, hull_from_order, hull_order,
+    left_angle, match_vertices, perimeter, project_t, ray_segment, ring_angle, ring_angles,
+    ring_angles_matched, visit_sorted,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -324,6 +325,30 @@ pub(crate) struct LayoutCache {
     pub repair: Mutex<RepairCache>,
     /// Algorithm 1 on a leaf piece, keyed by [`piece_key`].
     leaf_runs: Mutex<HashMap<Vec<u64>, Arc<LeafRun>>>,
+    /// The builder after applying each layout's cut list ([`AppliedCuts`]).
+    applied: Mutex<Vec<Arc<AppliedCuts>>>,
+}
+
+/// A [`Builder`] (of the cache's region and options) right after [`Builder::apply_cut`] of
+/// each cut of `layout` in order. The rebuilds of [`chord_layout_cuts`] extend the cut list
+/// of the layout before them, so they can start from its state and apply only the new cuts.
+/// Exact: applying a cut reads and changes only the builder's cuts, tree nodes and pieces,
+/// which start from the region alone, so the state after a list of cuts is a function of the
+/// region and that list (matched bit for bit, [`same_cuts`]).
+struct AppliedCuts {
+    layout: Vec<(DVec2, DVec2)>,
+    cuts: Vec<(DVec2, DVec2)>,
+    nodes: Vec<TreeNode>,
+    pieces: Vec<Option<Piece>>,
+}
+
+/// Whether two cut lists are the same, coordinates compared bit for bit.
+fn same_cuts(a: &[(DVec2, DVec2)], b: &[(DVec2, DVec2)]) -> bool {
+    let bits = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| bits(x.0) == bits(y.0) && bits(x.1) == bits(y.1))
 }
 
 /// The exact content of a piece (vertex bits, edge tags with their cut ids, per ring).
@@ -358,8 +383,35 @@ fn layout_from_cuts_cached(
     let tol = crate::decomposition::boundary_tol(region);
     let mut b = Builder::new(region, opts);
     b.cache = cache.cloned();
-    for &(p, q) in cuts {
+    // start from the state of the longest cut list applied before that begins this one
+    let start = cache
+        .and_then(|c| {
+            let applied = c.applied.lock().ok()?;
+            applied
+                .iter()
+                .filter(|a| a.layout.len() <= cuts.len())
+                .filter(|a| same_cuts(&a.layout, &cuts[..a.layout.len()]))
+                .max_by_key(|a| a.layout.len())
+                .cloned()
+        })
+        .map_or(0, |a| {
+            b.cuts.clone_from(&a.cuts);
+            b.nodes.clone_from(&a.nodes);
+            b.pieces.clone_from(&a.pieces);
+            a.layout.len()
+        });
+    for &(p, q) in &cuts[start..] {
         b.apply_cut(p, q, tol, Step::Chord);
+    }
+    if let Some(c) = cache.filter(|_| start < cuts.len()) {
+        if let Ok(mut applied) = c.applied.lock() {
+            applied.push(Arc::new(AppliedCuts {
+                layout: cuts.to_vec(),
+                cuts: b.cuts.clone(),
+                nodes: b.nodes.clone(),
+                pieces: b.pieces.clone(),
+            }));
+        }
     }
     b.protected_cuts = b.cuts.len();
     b.run_auto_on_leaves()?;
@@ -496,6 +548,21 @@ impl AngleScreen {
         let (y, x) = Self::yx(prev, cur, next);
         y < 0.0 && (x >= 0.0 || y / x > 1e-6)
     }
+}
+
+/// Whether a candidate cut whose cheap terms are `pre` (and every later one: the candidates
+/// are sorted by `pre`) cannot beat the best score `best` so far.
+///
+/// Exact for the two-child score `s = ½·max(B₁, B₂) + ¼·(B₁ + B₂) + pre` (`B` a badness or a
+/// corner cost, never negative: the quad fit's corner score F is a sum of squares and ratios
+/// of lengths with its fixed non-negative weights, its fallback ½ + a mean of squares,
+/// `1 + κ₂ + κ₃` is at least 1 and a grade is 0, 1 or 3): the first two terms add up to some
+/// `X ≥ 0` (or
+/// NaN), and rounding is monotone, so `s = fl(X + pre) ≥ pre ≥ best` (or NaN): `s < best`,
+/// the test for a new best, fails. A later candidate has a `pre` at least as large (in the
+/// `total_cmp` order of the sort, only a NaN comes after, whose score is NaN).
+pub(crate) fn beyond_best(pre: f64, best: f64) -> bool {
+    pre >= best
 }
 
 impl<'a> Builder<'a> {
@@ -1115,10 +1182,11 @@ impl<'a> Builder<'a> {
 
     /// Badness B(P) of a hole-free piece: its corner score F* if it is approximately convex
     /// (it will be a block), else 1 + κ₂ + κ₃ (it will be cut again).
-    /// The ring's vertex angles are given (`angles[i]` = `ring_angle(ring, i)`), for the
-    /// concavity measures and the corner score.
-    fn badness_with_angles(&self, ring: &[DVec2], angles: &[f64]) -> f64 {
-        let c = concavity_with_angles(ring, angles);
+    /// The ring's vertex angles (`angles[i]` = `ring_angle(ring, i)`) and convex hull (as
+    /// [`concavity_with_hull`] takes it) are given, for the concavity measures and the corner
+    /// score.
+    fn badness_with_hull(&self, ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> f64 {
+        let c = concavity_with_hull(ring, angles, hull);
         if c.approximately_convex(&self.opts.tolerances) {
             quad_fit_with_angles(ring, angles)
         } else {
@@ -1131,7 +1199,9 @@ impl<'a> Builder<'a> {
         let ring = &piece.outer;
         let n = ring.len();
         let angle: Vec<f64> = ring_angles(&ring.pts);
-        let conc = concavity_with_angles(&ring.pts, &angle);
+        let hull_keys = hull_order(&ring.pts);
+        let (hull, distinct) = hull_from_order(&ring.pts, &hull_keys);
+        let conc = concavity_with_hull(&ring.pts, &angle, hull.clone());
         let area = piece.area();
         let sq = area.sqrt();
         let mut starts: Vec<usize> = (0..n)
@@ -1194,20 +1264,33 @@ impl<'a> Builder<'a> {
                     });
                 }
             }
-            cands.sort_by(|a, b| {
-                a.pre.total_cmp(&b.pre).then_with(|| {
-                    let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
-                    pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
-                })
-            });
+            // the candidates in the order of (pre, coordinates of the second end, position):
+            // the sequence a stable sort by pre and coordinates gives, sorted only as far as
+            // the search goes (`visit_sorted`)
+            let mut order: Vec<usize> = (0..cands.len()).collect();
+            let cmp = |&ka: &usize, &kb: &usize| {
+                let (a, b) = (&cands[ka], &cands[kb]);
+                a.pre
+                    .total_cmp(&b.pre)
+                    .then_with(|| {
+                        let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
+                        pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
+                    })
+                    .then(ka.cmp(&kb))
+            };
             let mut best: Option<(f64, Cand)> = None;
             let mut evaluated = 0;
-            for c in &cands {
+            visit_sorted(&mut order, cmp, |&k| {
+                let c = &cands[k];
                 if evaluated >= 60 {
-                    break;
+                    return false;
+                }
+                // no later candidate can win (exact, see `beyond_best`)
+                if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
+                    return false;
                 }
                 if !piece.admissible(&idx, c.e1, c.e2) {
-                    continue;
+                    return true;
                 }
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);
@@ -1220,11 +1303,11 @@ impl<'a> Builder<'a> {
                     self.min_area
                 };
                 if aa < min_area || ab < min_area {
-                    continue;
+                    return true;
                 }
                 evaluated += 1;
                 // the children's vertex angles from the piece's where a vertex keeps its
-                // neighbours (exact, `ring_angles_from`): `a` starts at the cut's first end
+                // neighbours (exact, `ring_angles_matched`): `a` starts at the cut's first end
                 // (vertex `i` of the piece), `b` at its second end (a vertex, or a point inside
                 // an edge followed by the edge's end)
                 let start_b = match c.e2.pos {
@@ -1235,19 +1318,33 @@ impl<'a> Builder<'a> {
                     Pos::Vertex(i) => i,
                     Pos::OnEdge(e, _) => e + 1,
                 };
-                let ba = self.badness_with_angles(
-                    &a.outer.pts,
-                    &ring_angles_from(&a.outer.pts, &ring.pts, &angle, start_a),
-                );
-                let bb = self.badness_with_angles(
-                    &b.outer.pts,
-                    &ring_angles_from(&b.outer.pts, &ring.pts, &angle, start_b),
-                );
+                // and their convex hulls from the piece's: the piece's hull where the child
+                // keeps its vertices (`child_hull`), else from the piece's sorted points for a
+                // large child (`child_hull_order`; both exact, for pairwise different points)
+                let badness = |child: &[DVec2], start: usize| {
+                    let map = match_vertices(child, &ring.pts, start);
+                    let angles = ring_angles_matched(child, &ring.pts, &angle, &map);
+                    let large = 8 * child.len() >= n;
+                    let hull = distinct
+                        .then(|| child_hull(&ring.pts, &hull, child, &map))
+                        .flatten()
+                        .or_else(|| {
+                            let keys = (distinct && large)
+                                .then(|| child_hull_order(&hull_keys, n, child, &map))
+                                .flatten()?;
+                            Some(hull_from_order(child, &keys).0)
+                        })
+                        .unwrap_or_else(|| convex_hull(child));
+                    self.badness_with_hull(child, &angles, hull)
+                };
+                let ba = badness(&a.outer.pts, start_a);
+                let bb = badness(&b.outer.pts, start_b);
                 let s = 0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre;
                 if best.as_ref().is_none_or(|b| s < b.0) {
                     best = Some((s, *c));
                 }
-            }
+                true
+            });
             if let Some((_, c)) = best {
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);

@@ -34,6 +34,7 @@ use std::collections::{BTreeMap, HashSet, VecDeque};
 use std::f64::consts::PI;
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use unamalla_mesh::geometry::point_segment_distance;
 use unamalla_mesh::{DVec2, Region};
 
 use crate::geom::{angle_penalty, left_angle};
@@ -342,10 +343,14 @@ impl ChordMesh {
 
 /// The dual spanning tree of one simply connected piece of a [`ChordMesh`]: triangles in DFS
 /// preorder, each one's parent and the dual edge to it, and subtree areas.
+///
+/// `parent` and `sub` are indexed by triangle id (dense vectors over all the mesh's
+/// triangles; entries outside the piece stay `None` / 0): the same values, summed in the same
+/// order, as a map keyed by triangle would hold, without the map's per-entry work.
 struct PieceTree {
     order: Vec<usize>,
-    parent: BTreeMap<usize, (usize, usize)>,
-    sub: BTreeMap<usize, f64>,
+    parent: Vec<Option<(usize, usize)>>,
+    sub: Vec<f64>,
     total: f64,
 }
 
@@ -357,8 +362,10 @@ impl PieceTree {
         seed: usize,
         open: &dyn Fn(usize, usize) -> Option<usize>,
     ) -> Option<Self> {
-        let mut parent: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
-        let mut seen: HashSet<usize> = HashSet::from([seed]);
+        let nt = m.tris.len();
+        let mut parent: Vec<Option<(usize, usize)>> = vec![None; nt];
+        let mut seen = vec![false; nt];
+        seen[seed] = true;
         let mut dfs = vec![seed];
         let mut order = Vec::new();
         let mut dual_edges = 0usize;
@@ -367,8 +374,9 @@ impl PieceTree {
             for k in 0..3 {
                 if let Some(u) = open(x, k) {
                     dual_edges += 1;
-                    if seen.insert(u) {
-                        parent.insert(u, (x, k));
+                    if !seen[u] {
+                        seen[u] = true;
+                        parent[u] = Some((x, k));
                         dfs.push(u);
                     }
                 }
@@ -377,15 +385,17 @@ impl PieceTree {
         if dual_edges / 2 + 1 != order.len() {
             return None;
         }
-        let mut sub: BTreeMap<usize, f64> = BTreeMap::new();
+        // children before parents: a triangle's entry holds the sum of its children's
+        // subtrees (0.0 + s₁ + s₂ …, in this order) when it is reached
+        let mut sub = vec![0.0; nt];
         for &x in order.iter().rev() {
-            let s = m.tri_area(x) + sub.get(&x).copied().unwrap_or(0.0);
-            sub.insert(x, s);
-            if let Some(&(p, _)) = parent.get(&x) {
-                *sub.entry(p).or_insert(0.0) += s;
+            let s = m.tri_area(x) + sub[x];
+            sub[x] = s;
+            if let Some((p, _)) = parent[x] {
+                sub[p] += s;
             }
         }
-        let total = sub.get(&seed).copied().unwrap_or(0.0);
+        let total = sub[seed];
         Some(Self {
             order,
             parent,
@@ -401,9 +411,9 @@ impl PieceTree {
         m: &'a ChordMesh,
     ) -> impl Iterator<Item = (usize, usize, f64, usize)> + 'a {
         self.order.iter().filter_map(move |&x| {
-            let &(p, k) = self.parent.get(&x)?;
+            let (p, k) = self.parent[x]?;
             let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
-            Some((a, b, self.sub.get(&x).copied().unwrap_or(0.0), x))
+            Some((a, b, self.sub[x], x))
         })
     }
 }
@@ -432,6 +442,117 @@ pub fn neck_score(ring: &[DVec2]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// A neck score that no chord of a block reaches when [`arm_free`] holds: [`arm_chord`] with
+/// a `min_score` at least this large finds nothing there.
+const ARM_FREE_SCORE: f64 = 3.5;
+
+/// `true` if no chord of [`arm_chord`]'s triangulation of the block `ring` (a simple ring of
+/// area `area` and perimeter `per`, sampled every `per/400`) with both ends on edges `i`
+/// with `eligible[i]` has a neck score `min(A₁, A₂)/w²` of [`ARM_FREE_SCORE`] or more —
+/// decided from the ring's edges in O(n²), without the triangulation. `false` means only
+/// "not shown".
+///
+/// Why. A chord of length `w` from `x` (on edge `e`) to `y` (on edge `f ≠ e`: two samples of
+/// one edge are joined by boundary edges only) cuts the block into two simple polygons, each
+/// bounded by the chord and one boundary arc between `x` and `y`; a side whose arc has
+/// length `L` has an area of at most `(L + w)²/(4π)` (isoperimetric inequality). The test
+/// asks, for every pair of eligible edges, one of:
+///
+/// * the directions of the edges `e, e+1, …, f` (or of `f, …, e`), unwrapped along the
+///   chain by its turning angles, spread over less than `Θ = 2·acos(1/5)` (≈ 156.9°): then
+///   they all lie within `Θ/2` of one direction `u`, so for the arc `γ` along them
+///   `w ≥ (y − x)·u ≥ cos(Θ/2)·|γ| = |γ|/5`, and the side bounded by `γ` has an area of at
+///   most `(6w)²/(4π) < 2.9·w²`;
+/// * the two edges are farther apart than `R = √(A/6)`: then `w > R`, and the smaller side
+///   has at most `A/2 < 3·w²`.
+///
+/// So every such chord scores below 3. The triangulation computes the score from its
+/// samples (rounded points on the edges) and from sums of rounded triangle areas, and the
+/// test leaves room for that. Consecutive samples are at least `g` apart (the shortest edge,
+/// or a hundredth of the spacing, which [`ChordMesh::new`] keeps between a neck foot and any
+/// other sample), so a chord — its ends are not consecutive samples either way round — is
+/// at least `min(0.4·g, R)` long (under the first case its arc holds two sample gaps). A
+/// sample is off its edge by less than `δ = 4ε·max|coordinate|`, which the test bounds by
+/// 5·10⁻⁸·g (directions and lengths along the samples then differ from the edges' by less
+/// than 10⁻⁷, far inside the margins on `Θ` and `R`). For `N` triangles (at most twice the
+/// samples: `per/spacing + n` on the edges and at most one neck foot per vertex and nearby
+/// edge), the area error `δ·per + 10·N·ε·per²` (a generous bound of the moved boundary, of
+/// the rounded triangle areas and of their sums) is below `0.4·w²`. The computed score then
+/// stays below `(3 + 0.4)·(1 + 10⁻⁶) < 3.5`.
+fn arm_free(ring: &[DVec2], eligible: &[bool], area: f64, per: f64) -> bool {
+    let n = ring.len();
+    if n < 3 || !(area > 0.0) || !(per > 0.0) {
+        return false;
+    }
+    let spacing = per / 400.0;
+    let edge = |i: usize| (ring[i], ring[(i + 1) % n]);
+    let min_edge = (0..n)
+        .map(|i| edge(i).0.distance(edge(i).1))
+        .fold(f64::INFINITY, f64::min);
+    let gap = min_edge.min(0.01 * spacing);
+    let max_coord = ring
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f64::max);
+    // a sample (a rounded point on its edge) is off the edge by less than `delta`
+    let delta = 4.0 * f64::EPSILON * max_coord;
+    if !(gap > 0.0) || 2.0 * delta > 1e-7 * gap {
+        return false;
+    }
+    let r = (area / 6.0).sqrt();
+    // the distance of two edges (they meet only if they are consecutive: a simple ring)
+    let dist = |e: usize, f: usize| {
+        let ((a, b), (c, d)) = (edge(e), edge(f));
+        point_segment_distance(a, c, d)
+            .min(point_segment_distance(b, c, d))
+            .min(point_segment_distance(c, a, b))
+            .min(point_segment_distance(d, a, b))
+    };
+    // an upper bound of the neck feet: a vertex closer than half a spacing to an edge not at
+    // it may give one
+    let feet = (0..n)
+        .map(|v| {
+            (0..n)
+                .filter(|&f| f != v && (f + 1) % n != v)
+                .filter(|&f| point_segment_distance(ring[v], edge(f).0, edge(f).1) < spacing)
+                .count()
+        })
+        .sum::<usize>();
+    // samples: at most per/spacing + n on the edges, plus the feet; triangles fewer than
+    // twice the samples
+    let triangles = 2.0 * (400.0 + (n + feet) as f64 + 1.0);
+    let w_min = (0.4 * gap).min(r);
+    if delta * per + 10.0 * triangles * f64::EPSILON * per * per >= 0.4 * w_min * w_min {
+        return false;
+    }
+    // turning angle at vertex i + 1, from edge i to edge i + 1
+    let dir = |i: usize| edge(i).1 - edge(i).0;
+    let turn: Vec<f64> = (0..n)
+        .map(|i| {
+            let (u, v) = (dir(i), dir((i + 1) % n));
+            u.perp_dot(v).atan2(u.dot(v))
+        })
+        .collect();
+    // spread[e·n + f]: spread of the unwrapped directions of the edges e, e+1, …, f
+    let mut spread = vec![0.0; n * n];
+    for e in 0..n {
+        let (mut th, mut lo, mut hi) = (0.0f64, 0.0f64, 0.0f64);
+        for k in 1..n {
+            th += turn[(e + k - 1) % n];
+            lo = lo.min(th);
+            hi = hi.max(th);
+            spread[e * n + (e + k) % n] = hi - lo;
+        }
+    }
+    // Θ, less a margin far above the rounding of the directions
+    let theta = 2.0 * 0.2f64.acos() - 1e-6;
+    (0..n).filter(|&e| eligible[e]).all(|e| {
+        (e + 1..n).filter(|&f| eligible[f]).all(|f| {
+            spread[e * n + f] < theta || spread[f * n + e] < theta || dist(e, f) > 1.01 * r
+        })
+    })
+}
+
 /// The best **arm cut** of a block: the chord with the highest `min(A₁, A₂)/w²`, at least
 /// `min_score`, whose ends both lie on edges with `on_boundary[i]` (original region boundary,
 /// so the chord is a valid cut of the region), strictly inside those edges or at their
@@ -444,12 +565,6 @@ pub(crate) fn arm_chord(
     min_area: f64,
 ) -> Option<(DVec2, DVec2)> {
     let region = Region::new(ring.to_vec(), vec![]).ok()?;
-    let m = ChordMesh::new(&region, region.perimeter() / 400.0).ok()?;
-    if m.tris.is_empty() {
-        return None;
-    }
-    let open = |t: usize, k: usize| m.nbr[t][k];
-    let tree = PieceTree::new(&m, 0, &open)?;
     // Region::new may have reversed the ring: map edges by their end points
     let n = ring.len();
     let boundary_edge = |i: usize| {
@@ -463,6 +578,24 @@ pub(crate) fn arm_chord(
                     || (ring[k] == b && ring[(k + 1) % n] == a))
         })
     };
+    let on: Vec<bool> = (0..n).map(boundary_edge).collect();
+    // most blocks have no arm: shown without the triangulation, the costliest step
+    if min_score >= ARM_FREE_SCORE
+        && arm_free(
+            region.outer().points(),
+            &on,
+            region.area(),
+            region.perimeter(),
+        )
+    {
+        return None;
+    }
+    let m = ChordMesh::new(&region, region.perimeter() / 400.0).ok()?;
+    if m.tris.is_empty() {
+        return None;
+    }
+    let open = |t: usize, k: usize| m.nbr[t][k];
+    let tree = PieceTree::new(&m, 0, &open)?;
     let min_angle = MIN_END_ANGLE_DEG.to_radians();
     let mut best: Option<(f64, usize, usize)> = None;
     for (a, b, a1, _) in tree.chords(&m) {
@@ -472,7 +605,7 @@ pub(crate) fn arm_chord(
         if small < min_area || score < min_score || best.is_some_and(|(s, _, _)| s >= score) {
             continue;
         }
-        if !boundary_edge(m.edge[a]) || !boundary_edge(m.edge[b]) {
+        if !on[m.edge[a]] || !on[m.edge[b]] {
             continue;
         }
         let (amin, _) = m.chord_angles(a, b);
@@ -868,6 +1001,79 @@ mod tests {
         let expect = area(&left).min(area(&right)) / (w * w);
         let s = neck_score(&ring);
         assert!((s / expect - 1.0).abs() < 1e-6, "{s} vs {expect}");
+    }
+
+    /// Where `arm_free` holds, no chord of the triangulation scores [`ARM_FREE_SCORE`] or
+    /// more (`neck_score`: the largest score over the same chords), on rectangles of many
+    /// aspects, regular polygons and pseudo-random star-shaped rings; and it holds for fat
+    /// shapes, fails for a dumbbell.
+    #[test]
+    fn arm_free_blocks_have_no_chord_near_the_arm_score() {
+        let v = DVec2::new;
+        let check = |ring: &[DVec2]| -> bool {
+            let region = Region::new(ring.to_vec(), vec![]).expect("ring");
+            let pts = region.outer().points();
+            let free = arm_free(
+                pts,
+                &vec![true; pts.len()],
+                region.area(),
+                region.perimeter(),
+            );
+            if free {
+                let s = neck_score(ring);
+                assert!(s < ARM_FREE_SCORE, "score {s} for {ring:?}");
+            }
+            free
+        };
+        let mut shown = 0;
+        for k in 1..40 {
+            let a = 1.0 + 0.25 * k as f64;
+            shown += check(&[v(0.0, 0.0), v(a, 0.0), v(a, 1.0), v(0.0, 1.0)]) as usize;
+        }
+        for n in 3..24 {
+            let ring: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * i as f64 / n as f64;
+                    v(t.cos(), t.sin())
+                })
+                .collect();
+            assert!(check(&ring), "a regular {n}-gon has no arm");
+        }
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let n = 3 + (next() * 60.0) as usize;
+            let (sx, sy) = (0.2 + 3.0 * next(), 0.2 + 3.0 * next());
+            let ring: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * (i as f64 + 0.8 * next()) / n as f64;
+                    let r = 0.3 + next();
+                    v(sx * r * t.cos(), sy * r * t.sin())
+                })
+                .collect();
+            shown += check(&ring) as usize;
+        }
+        assert!(shown > 50, "{shown}");
+        let dumbbell = [
+            v(0.0, 0.0),
+            v(4.0, 0.0),
+            v(4.0, 1.5),
+            v(5.0, 1.5),
+            v(5.0, 0.0),
+            v(9.0, 0.0),
+            v(9.0, 4.0),
+            v(5.0, 4.0),
+            v(5.0, 2.5),
+            v(4.0, 2.5),
+            v(4.0, 4.0),
+            v(0.0, 4.0),
+        ];
+        assert!(!check(&dumbbell));
     }
 
     #[test]

@@ -27,10 +27,10 @@
 //! four cells meet at the tip.
 
 use serde::{Deserialize, Serialize};
-use unamalla_mesh::geometry::{convex_hull, point_segment_distance};
+use unamalla_mesh::geometry::point_segment_distance;
 use unamalla_mesh::DVec2;
 
-use crate::geom::{diameter, perimeter, ring_angle, ring_angles, signed_area};
+use crate::geom::{convex_hull, diameter, perimeter, ring_angle, ring_angles, signed_area};
 
 /// Tolerances of the concavity criteria and the critical angle (thesis Obs 4.8, §4.1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -119,6 +119,13 @@ pub fn concavity(ring: &[DVec2]) -> Concavity {
 /// [`ring_angles`]; ignored for fewer than three vertices). The same result bit for bit: the
 /// largest angle is folded over the same values in the same order.
 pub(crate) fn concavity_with_angles(ring: &[DVec2], angles: &[f64]) -> Concavity {
+    concavity_with_hull(ring, angles, convex_hull(ring))
+}
+
+/// [`concavity_with_angles`] with the ring's convex hull given: `hull` holds the indices
+/// that `convex_hull(ring)` returns, in their cyclic order, from any of them on (the
+/// measures start it at its smallest index).
+pub(crate) fn concavity_with_hull(ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> Concavity {
     let n = ring.len();
     let max_angle = if n < 3 {
         0.0
@@ -126,7 +133,7 @@ pub(crate) fn concavity_with_angles(ring: &[DVec2], angles: &[f64]) -> Concavity
         debug_assert_eq!(angles.len(), n);
         angles.iter().copied().fold(0.0, f64::max)
     };
-    let mut hull = convex_hull(ring);
+    let mut hull = hull;
     let mut point_kappa3 = vec![0.0; n];
     let mut point_kappa4 = vec![0.0; n];
     if n < 3 || hull.len() < 3 {

@@ -604,8 +604,9 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
                 point_segment_distance(p, a, b) <= tol
             });
             // a joint where a cut was split by the triangle-block rule: shared with another cut
-            let joint = cuts.iter().any(|d| d.id != c.id && (d.a == p || d.b == p));
-            if !on && !joint {
+            // (only looked for when the end is not on the boundary: the test is pure)
+            let joint = || cuts.iter().any(|d| d.id != c.id && (d.a == p || d.b == p));
+            if !on && !joint() {
                 return Err(DecomposeError::CutEndNotOnBoundary {
                     cut: c.id,
                     endpoint: name,
@@ -635,8 +636,8 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
             .min(0.25);
         let a2 = c.a + shrink * d;
         let b2 = c.b - shrink * d;
-        if !(region.contains_point(a2)
-            && region.contains_point(b2)
+        if !(contains_point_with(region, &index, a2)
+            && contains_point_with(region, &index, b2)
             && !index.open_segment_blocked(a2, b2))
         {
             return Err(err);
@@ -660,6 +661,39 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
         }
     }
     Ok(())
+}
+
+/// [`Region::contains_point`] (`p` in the open region) with `index` =
+/// [`Region::edge_index`] of `region`, looking only at the edges whose bounding box meets the
+/// horizontal ray from `p` to the right.
+///
+/// The same answer: `contains_point` locates `p` in each ring by the winding number of
+/// `locate_in_ring` (an edge counts +1 if it goes up across the height of `p` with `p`
+/// strictly on its left, −1 if it goes down with `p` strictly on its right, both by the
+/// exact `orient2d`), and `p` on any edge (exactly) is on the boundary. An edge that counts
+/// crosses the height of `p` to its right, and an edge holding `p` holds it in its bounding
+/// box: either way the box meets the ray, so the edges left out count 0 and do not hold `p`.
+/// The rules are evaluated here on the same numbers with the same predicates. `p` is inside
+/// exactly when it is on no edge, the outer ring's winding number is not 0 and every hole's
+/// is (a point inside a hole or on any ring is not in the open region).
+pub(crate) fn contains_point_with(region: &Region, index: &SegmentIndex, p: DVec2) -> bool {
+    let (_, hi) = region.bounding_box();
+    let mut winding = vec![0i64; region.rings().count()];
+    for er in index.candidates(p, DVec2::new(hi.x, p.y)) {
+        let (a, b) = index.edge(er);
+        let o = unamalla_mesh::geometry::orient2d(a, b, p);
+        if o == 0.0 && unamalla_mesh::geometry::point_on_segment(a, b, p) {
+            return false;
+        }
+        if a.y <= p.y {
+            if b.y > p.y && o > 0.0 {
+                winding[er.ring] += 1;
+            }
+        } else if b.y <= p.y && o < 0.0 {
+            winding[er.ring] -= 1;
+        }
+    }
+    winding[0] != 0 && winding[1..].iter().all(|&w| w == 0)
 }
 
 /// Corners: four distinct indices in range, in counter-clockwise ring order, none reflex.
@@ -704,4 +738,50 @@ pub(crate) fn check_corners(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `contains_point_with` answers as `Region::contains_point` on a region with a hole and
+    /// horizontal edges, at vertices, on edges, at the heights of vertices and elsewhere.
+    #[test]
+    fn indexed_point_location_matches_contains_point() {
+        let v = DVec2::new;
+        let region = Region::new(
+            vec![
+                v(0.0, 0.0),
+                v(6.0, 0.0),
+                v(6.0, 2.0),
+                v(4.0, 2.0),
+                v(5.0, 4.0),
+                v(6.0, 6.0),
+                v(0.0, 6.0),
+                v(1.0, 3.0),
+            ],
+            vec![vec![v(2.0, 2.0), v(2.0, 4.0), v(3.0, 4.0), v(3.0, 2.0)]],
+        )
+        .expect("region");
+        let index = region.edge_index();
+        let mut points: Vec<DVec2> = region.rings().flat_map(|r| r.points().to_vec()).collect();
+        for r in region.rings() {
+            let p = r.points();
+            for k in 0..p.len() {
+                points.push(0.5 * (p[k] + p[(k + 1) % p.len()]));
+            }
+        }
+        for i in 0..=28 {
+            for j in 0..=28 {
+                points.push(v(-0.5 + 0.25 * i as f64, -0.5 + 0.25 * j as f64));
+            }
+        }
+        for p in points {
+            assert_eq!(
+                contains_point_with(&region, &index, p),
+                region.contains_point(p),
+                "{p:?}"
+            );
+        }
+    }
 }

@@ -202,8 +202,10 @@ impl Piece {
         let r = &self.outer;
         let n = r.len();
         let take = |from: usize, to: usize| -> Ring {
-            let mut pts = Vec::new();
-            let mut tags = Vec::new();
+            // the vertices `from` … `to`, cyclically
+            let len = (to + n - from) % n + 1;
+            let mut pts = Vec::with_capacity(len);
+            let mut tags = Vec::with_capacity(len);
             let mut k = from;
             loop {
                 pts.push(r.pts[k]);

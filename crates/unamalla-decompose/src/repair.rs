@@ -53,15 +53,17 @@
 //!    than a less admissible block. [`Decomposition::cut_joints`](crate::Decomposition::cut_joints)
 //!    lists the joints that remain (none on the fixture regions, tested).
 
+use std::cell::Cell;
+
 use rayon::prelude::*;
 use unamalla_mesh::DVec2;
 
-use crate::auto::{needs_cut_point, triangle_plan, Builder};
+use crate::auto::{beyond_best, needs_cut_point, triangle_plan, Builder};
 use crate::concavity::{concavity, concavity_with_angles, critical_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
-use crate::geom::ring_angles;
+use crate::geom::{ring_angles, visit_sorted};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
@@ -255,22 +257,36 @@ struct Neighbourhood {
     key: Vec<u64>,
 }
 
-impl Neighbourhood {
-    /// The neighbourhood of block slot `k`.
-    fn new(slot: &[Option<Ring>], k: usize, alive: &[bool], protected: usize) -> Self {
-        // the slots holding each cut, in slot order (as `neighbour_unions` searches them)
-        let mut holders: std::collections::HashMap<usize, Vec<usize>> =
-            std::collections::HashMap::new();
-        for (j, o) in slot.iter().enumerate() {
-            for t in o.iter().flat_map(|r| r.tags.iter()) {
-                if let Tag::Cut(c) = *t {
-                    let h = holders.entry(c).or_default();
-                    if h.last() != Some(&j) {
-                        h.push(j);
-                    }
+/// The slots holding each cut, in slot order (as `neighbour_unions` searches them): what
+/// [`Neighbourhood::new`] follows from a block to its neighbours. A function of the slots
+/// alone, so [`Builder::repair_pass`] computes it once per state of the slots.
+type CutHolders = std::collections::HashMap<usize, Vec<usize>>;
+
+/// The [`CutHolders`] of `slot`.
+fn cut_holders(slot: &[Option<Ring>]) -> CutHolders {
+    let mut holders = CutHolders::new();
+    for (j, o) in slot.iter().enumerate() {
+        for t in o.iter().flat_map(|r| r.tags.iter()) {
+            if let Tag::Cut(c) = *t {
+                let h = holders.entry(c).or_default();
+                if h.last() != Some(&j) {
+                    h.push(j);
                 }
             }
         }
+    }
+    holders
+}
+
+impl Neighbourhood {
+    /// The neighbourhood of block slot `k`; `holders` = [`cut_holders`]`(slot)`.
+    fn new(
+        slot: &[Option<Ring>],
+        holders: &CutHolders,
+        k: usize,
+        alive: &[bool],
+        protected: usize,
+    ) -> Self {
         let mut slots = vec![k];
         let mut frontier = vec![k];
         for _ in 0..2 {
@@ -575,15 +591,25 @@ impl Builder<'_> {
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
         let need = if good_only { 2 } else { 0 };
-        self.for_each_split(ring, quarter_points, need, &mut |pre, a, b, ends| {
-            let (Some(fa), Some(fb)) = (accept(&a), accept(&b)) else {
-                return;
-            };
-            let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
-            if best.as_ref().is_none_or(|b| s < b.0) {
-                best = Some((s, a, b, ends));
-            }
-        });
+        // the best score so far: the search ends at the first candidate whose cheap terms
+        // reach it (exact, `beyond_best`: `accept` costs are never negative)
+        let bound = Cell::new(f64::NAN);
+        self.for_each_split(
+            ring,
+            quarter_points,
+            need,
+            Some(&bound),
+            &mut |pre, a, b, ends| {
+                // `accept` is pure: the second child is not looked at when the first fails
+                let Some(fa) = accept(&a) else { return };
+                let Some(fb) = accept(&b) else { return };
+                let s = 0.5 * fa.max(fb) + 0.25 * (fa + fb) + pre;
+                if best.as_ref().is_none_or(|b| s < b.0) {
+                    bound.set(s);
+                    best = Some((s, a, b, ends));
+                }
+            },
+        );
         best
     }
 
@@ -597,11 +623,17 @@ impl Builder<'_> {
     /// children are good ([`Builder::good_fit`]): a counted candidate (it still counts towards
     /// the 80) whose children cannot be is not built or visited ([`ChildScreen`]), and when no
     /// candidate can pass, nothing is searched. `need` = 0 visits every counted candidate.
+    ///
+    /// With a `bound` (the caller's best two-child score so far, NaN while there is none),
+    /// the search ends at the first candidate whose `pre` reaches it: the caller keeps a
+    /// candidate only if it scores below the bound, which no candidate from there on can
+    /// (`beyond_best`).
     fn for_each_split(
         &self,
         ring: &Ring,
         quarter_points: bool,
         need: usize,
+        bound: Option<&Cell<f64>>,
         visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
     ) {
         let n = ring.len();
@@ -663,40 +695,45 @@ impl Builder<'_> {
                 cands.push((w.angle * pen + w.length * p.distance(q) / sq, e1, e2));
             }
         }
-        // a stable sort of (pre, position) pairs by the candidates' order: the same sequence
-        // as a stable sort of the candidates themselves, with less to move
+        // the candidates in the order of (pre, coordinates of both ends, position): the
+        // sequence a stable sort by pre and coordinates gives, sorted only as far as the
+        // search goes (`visit_sorted`)
         let mut order: Vec<(f64, usize)> = (0..cands.len()).map(|k| (cands[k].0, k)).collect();
-        order.sort_by(|&(sa, ka), &(sb, kb)| {
-            sa.total_cmp(&sb).then_with(|| {
-                let (a, b) = (&cands[ka], &cands[kb]);
-                let (pa, pb) = (piece.point(a.1), piece.point(b.1));
-                let (qa, qb) = (piece.point(a.2), piece.point(b.2));
-                pa.x.total_cmp(&pb.x)
-                    .then(pa.y.total_cmp(&pb.y))
-                    .then(qa.x.total_cmp(&qb.x))
-                    .then(qa.y.total_cmp(&qb.y))
-            })
-        });
         let mut evaluated = 0;
-        for (pre, e1, e2) in order.into_iter().map(|(_, k)| cands[k]) {
-            if evaluated >= 80 {
-                break;
+        let cmp = |&(sa, ka): &(f64, usize), &(sb, kb): &(f64, usize)| {
+            sa.total_cmp(&sb)
+                .then_with(|| {
+                    let (a, b) = (&cands[ka], &cands[kb]);
+                    let (pa, pb) = (piece.point(a.1), piece.point(b.1));
+                    let (qa, qb) = (piece.point(a.2), piece.point(b.2));
+                    pa.x.total_cmp(&pb.x)
+                        .then(pa.y.total_cmp(&pb.y))
+                        .then(qa.x.total_cmp(&qb.x))
+                        .then(qa.y.total_cmp(&qb.y))
+                })
+                .then(ka.cmp(&kb))
+        };
+        visit_sorted(&mut order, cmp, |&(_, k)| {
+            let (pre, e1, e2) = cands[k];
+            if evaluated >= 80 || bound.is_some_and(|b| beyond_best(pre, b.get())) {
+                return false;
             }
             if !piece.admissible(&idx, e1, e2) {
-                continue;
+                return true;
             }
             evaluated += 1;
             if screen
                 .as_ref()
                 .is_some_and(|c| c.possibly_good(e1, e2) < need)
             {
-                continue;
+                return true;
             }
             let mut m = piece.clone();
             let (x, y) = m.insert_ends(e1, e2);
             let (a, b) = m.split(x, y, TMP_CUT);
             visit(pre, a.outer, b.outer, (m.outer.p(x), m.outer.p(y)));
-        }
+            true
+        });
     }
 
     /// The best split of `ring` by **two** cuts into three blocks that `accept` takes (step 3
@@ -722,9 +759,15 @@ impl Builder<'_> {
             let mut firsts = Vec::new();
             // a first cut is followed only if it leaves exactly one accepted child
             let need = if good_only { 1 } else { 0 };
-            self.for_each_split(ring, quarter_points, need, &mut |pre1, a, b, ends1| {
-                firsts.push((pre1, a, b, ends1));
-            });
+            self.for_each_split(
+                ring,
+                quarter_points,
+                need,
+                None,
+                &mut |pre1, a, b, ends1| {
+                    firsts.push((pre1, a, b, ends1));
+                },
+            );
             let found: Vec<Option<Resplit>> = firsts
                 .into_par_iter()
                 .map(|(pre1, a, b, ends1)| {
@@ -825,13 +868,18 @@ impl Builder<'_> {
     ) -> Option<Merge> {
         let mut best: Option<Merge> = None;
         let r = slot[k].as_ref()?;
-        for (j, c, u) in self.neighbour_unions(slot, r, &[k], alive) {
-            let option = match accept(&u) {
+        let unions = self.neighbour_unions(slot, r, &[k], alive);
+        // the unions are searched in parallel and compared in order (the searches are pure)
+        let options: Vec<Option<(f64, Option<Split>)>> = unions
+            .par_iter()
+            .map(|(_, _, u)| match accept(u) {
                 Some(cost) => Some((cost, None)),
                 None => self
-                    .best_split_by(&u, accept, good_only)
+                    .best_split_by(u, accept, good_only)
                     .map(|s| (s.0, Some(s))),
-            };
+            })
+            .collect();
+        for ((j, c, u), option) in unions.into_iter().zip(options) {
             if let Some((s, split)) = option {
                 if beats(
                     s,
@@ -913,51 +961,66 @@ impl Builder<'_> {
             }
             hosts.push((Host::Merged { j, c }, u));
         }
-        hosts.append(&mut hosts2);
         let memo = FitMemo::default();
-        // corner scores of the good blocks among the hosts' blocks, each computed once
-        let mut fits: Vec<(usize, Option<f64>)> = Vec::new();
-        let mut best: Option<(Host, Resplit)> = None;
-        for (host, u) in hosts {
-            // the fewest blocks disturbed: two neighbours only when no re-split of the block
-            // alone or with one neighbour works
-            if matches!(host, Host::Merged2 { .. }) && best.is_some() {
-                break;
-            }
+        // the candidates of one host, in the order the search yields them: the split of a
+        // union with two neighbours by one cut, then the split by two cuts
+        let candidates = |(host, u): &(Host, Ring)| -> Vec<Resplit> {
             // a good neighbour may not come out with a worse corner score than RESPLIT_SLACK
             // above the worst good block it replaces (gulf-of-mexico: the repair of a small
             // block re-cornered the 39-vertex central basin, F 0.13 → 0.20, whose transfinite
             // grid then folded over more area than it covered)
-            let mut limit = f64::NEG_INFINITY;
-            for s in host.parts(k).0 {
-                let f = match fits.iter().find(|f| f.0 == s) {
-                    Some(&(_, f)) => f,
-                    None => {
-                        let f = slot[s].as_ref().and_then(|r| self.good_fit(r));
-                        fits.push((s, f));
-                        f
-                    }
-                };
-                if let Some(f) = f {
-                    limit = limit.max(f + RESPLIT_SLACK);
-                }
-            }
-            if limit == f64::NEG_INFINITY {
-                limit = f64::INFINITY;
-            }
+            let limit = host
+                .parts(k)
+                .0
+                .iter()
+                .filter_map(|&s| slot[s].as_ref().and_then(|r| memo.good_fit(self, r)))
+                .map(|f| f + RESPLIT_SLACK)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let limit = if limit == f64::NEG_INFINITY {
+                f64::INFINITY
+            } else {
+                limit
+            };
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
             let two = matches!(host, Host::Merged2 { .. })
-                .then(|| self.best_split_by(&u, &good, true))
+                .then(|| self.best_split_by(u, &good, true))
                 .flatten()
                 .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
-            for s in two.into_iter().chain(self.best_split3(&u, &good, true)) {
+            two.into_iter()
+                .chain(self.best_split3(u, &good, true))
+                .collect()
+        };
+        // the lowest score wins, candidates compared in host order (as a sequential loop
+        // over the hosts would: the searches are pure, the memo only saves work)
+        let fold = |best: &mut Option<(Host, Resplit)>, host: Host, found: Vec<Resplit>| {
+            for s in found {
                 if beats(
                     s.0,
                     ring_key(&s.1[0]),
                     best.as_ref().map(|(_, b)| (b.0, ring_key(&b.1[0]))),
                 ) {
-                    best = Some((host, s));
+                    *best = Some((host, s));
                 }
+            }
+        };
+        let mut best: Option<(Host, Resplit)> = None;
+        let found: Vec<Vec<Resplit>> = hosts.par_iter().map(candidates).collect();
+        for ((host, _), f) in hosts.iter().zip(found) {
+            fold(&mut best, *host, f);
+        }
+        // the fewest blocks disturbed: two neighbours only when no re-split of the block
+        // alone or with one neighbour works, and only up to the first of those that works
+        // (searched a few at a time in parallel: a later one would be searched in vain)
+        for chunk in hosts2.chunks(rayon::current_num_threads().max(1)) {
+            if best.is_some() {
+                break;
+            }
+            let found: Vec<Vec<Resplit>> = chunk.par_iter().map(candidates).collect();
+            for ((host, _), f) in chunk.iter().zip(found) {
+                if best.is_some() {
+                    break;
+                }
+                fold(&mut best, *host, f);
             }
         }
         best
@@ -1174,6 +1237,9 @@ impl Builder<'_> {
         // block, its neighbours and theirs (and the live cuts between them), so while those
         // are unchanged a later sweep would fail again on the same candidates
         let mut failed: Vec<Option<Neighbourhood>> = Vec::new();
+        // the cut holders of the current slots, recomputed after each change of the slots
+        // (a failed attempt changes nothing, and most attempts fail)
+        let mut holders: Option<CutHolders> = None;
         while budget > 0 {
             if k >= slot.len() {
                 if !changed {
@@ -1189,13 +1255,18 @@ impl Builder<'_> {
                 k += 1;
                 continue;
             }
-            let nb = Neighbourhood::new(&slot, k, &alive, self.protected_cuts);
+            let held = holders.get_or_insert_with(|| cut_holders(&slot));
+            let nb = Neighbourhood::new(&slot, held, k, &alive, self.protected_cuts);
             if failed.get(k).is_some_and(|f| f.as_ref() == Some(&nb)) {
                 k += 1;
                 continue;
             }
             budget -= 1;
-            match self.cached_attempt(&slot, k, &alive, &r, &nb) {
+            let attempt = self.cached_attempt(&slot, k, &alive, &r, &nb);
+            if !matches!(attempt, Attempt::Fail) {
+                holders = None;
+            }
+            match attempt {
                 // 1. split alone
                 Attempt::Split((_, a, b, ends)) => {
                     let (a, b, id) = self.commit_split(a, b, ends);
