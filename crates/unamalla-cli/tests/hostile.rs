@@ -1269,7 +1269,7 @@ fn library_api_cases() {
         .mesh(&s)
         .unwrap();
     // the spike's cells cannot all be convex and inside a 2·10⁻⁷-wide spike: folded cells, or
-    // (since the #23 smoother keeps them convex) centroids outside the region
+    // (since the smoother keeps them convex) centroids outside the region
     let v = &r.report.verification;
     assert!(!v.passed());
     assert!(
