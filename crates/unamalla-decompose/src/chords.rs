@@ -30,6 +30,7 @@
 //! Chords ending within `max(s, w/2)` of an earlier cut end are skipped (no fans), as are
 //! chords making an angle below [`MIN_END_ANGLE_DEG`] with the boundary.
 
+use std::cmp::Ordering::Greater;
 use std::collections::{BTreeMap, HashSet, VecDeque};
 use std::f64::consts::PI;
 
@@ -481,7 +482,8 @@ const ARM_FREE_SCORE: f64 = 3.5;
 /// stays below `(3 + 0.4)·(1 + 10⁻⁶) < 3.5`.
 fn arm_free(ring: &[DVec2], eligible: &[bool], area: f64, per: f64) -> bool {
     let n = ring.len();
-    if n < 3 || !(area > 0.0) || !(per > 0.0) {
+    // (written so that NaN counts as not positive)
+    if n < 3 || area.partial_cmp(&0.0) != Some(Greater) || per.partial_cmp(&0.0) != Some(Greater) {
         return false;
     }
     let spacing = per / 400.0;
@@ -496,7 +498,7 @@ fn arm_free(ring: &[DVec2], eligible: &[bool], area: f64, per: f64) -> bool {
         .fold(0.0, f64::max);
     // a sample (a rounded point on its edge) is off the edge by less than `delta`
     let delta = 4.0 * f64::EPSILON * max_coord;
-    if !(gap > 0.0) || 2.0 * delta > 1e-7 * gap {
+    if gap.partial_cmp(&0.0) != Some(Greater) || 2.0 * delta > 1e-7 * gap {
         return false;
     }
     let r = (area / 6.0).sqrt();

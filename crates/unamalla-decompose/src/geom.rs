@@ -527,7 +527,7 @@ mod tests {
     /// `child_hull_order` gives the hull order a sort of the child gives, so the same hull.
     #[test]
     fn child_hull_orders_match_the_sorted_ones() {
-        let mut state = 0x0ddb_a11_5eed_u64;
+        let mut state = 0x00dd_ba11_5eed_u64;
         let mut next = move || {
             state ^= state << 13;
             state ^= state >> 7;
