@@ -1,4 +1,5 @@
-//! Corner selection (seed 000 digest §4.2, thesis §5.1.1) and the triangle-block rule.
+//! Corner selection ([Méndez 2023, §5.1.1]; the references are listed in `docs/references.md`
+//! of the repository) and the triangle-block rule.
 //!
 //! **Quadrilateral blocks.** Candidates are vertices with interior angle θ < θ_max (default
 //! 165°: neither reflex nor nearly collinear); when fewer than four qualify, every vertex with
@@ -8,7 +9,7 @@
 //! with fixed boundary nodes its corner triangle has α ≈ 0 and no smoothing can repair it.
 //! Blocks without four such vertices get no corners here; the decomposition repairs them with
 //! an extra cut (module `auto`). The 170° bound is ours (the thesis only says "not collinear",
-//! seed 000 digest §4.2); 165°–170° corners still give cells with a 165°–170° angle, which the
+//! [Méndez 2023, §5.1.1]); 165°–170° corners still give cells with a 165°–170° angle, which the
 //! smoother can only improve by moving interior nodes. Among the best `M` candidates (ranked by the angle penalty g(θ)), every
 //! cyclically ordered 4-tuple c₀ < c₁ < c₂ < c₃ is scored by
 //!

@@ -1,8 +1,8 @@
 //! The thesis's own corner heuristic, selectable beside the scoring of [`crate::corners`]:
-//! Méndez Cruz (2023), *Parametrización de regiones poligonales complicadas*, §5.1.1 — choose
-//! four vertices that are neither (nearly) collinear nor reflex with opposite sides of about
-//! equal length, implemented as "two diametrically opposite points of the convex hull and two
-//! more on the hull boundary so that opposite sides have the desired length ratio".
+//! [Méndez 2023, §5.1.1] (the references are listed in `docs/references.md` of the repository) —
+//! choose four vertices that are neither (nearly) collinear nor reflex with opposite sides of about
+//! equal length, implemented as "two diametrically opposite points of the convex hull and two more
+//! on the hull boundary so that opposite sides have the desired length ratio".
 //!
 //! Here, with the same candidate vertices as the scoring (interior angle below θ_max, or below
 //! θ_lim when fewer than four qualify):
@@ -36,7 +36,7 @@ pub enum CornerChoice {
     /// [`crate::corners`]).
     #[default]
     Scoring,
-    /// The thesis's convex-hull diametral heuristic (this module, Méndez Cruz 2023 §5.1.1).
+    /// The thesis's convex-hull diametral heuristic (this module, [Méndez 2023, §5.1.1]).
     Diametral,
 }
 

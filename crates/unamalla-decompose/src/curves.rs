@@ -3,11 +3,12 @@
 //! the curves that fills every block by transfinite interpolation.
 //!
 //! Every block side is split into curves `Q_j` — maximal runs of one region ring, or one whole
-//! cut — numbered block by block and side by side (the `J_{k,side}` convention of seed 000
-//! §5.2.1). [`BlockCurves::problem`] states the compatibility system (5.1)–(5.4) for them;
+//! cut — numbered block by block and side by side (the `J_{k,side}` convention of
+//! [Méndez 2023, §5.2.1]; the references are listed in `docs/references.md` of the
+//! repository). [`BlockCurves::problem`] states the compatibility system (5.1)–(5.4) for them;
 //! [`BlockCurves::predicted_cells`] gives the number of cells a set of counts makes without
 //! building the mesh: block `k` with `n_b` points on its bottom side and `n_l` on its left side
-//! has `(n_b − 1)(n_l − 1)` cells (seed 000 (5.5)/(5.6): `M_k × N_k` points);
+//! has `(n_b − 1)(n_l − 1)` cells ([Méndez 2023, (5.5), (5.6)]: `M_k × N_k` points);
 //! [`BlockCurves::grids`] resamples every curve with its count ([`resample_keeping_corners`])
 //! and fills the blocks by TFI.
 
@@ -20,7 +21,7 @@ use unamalla_mesh::{tfi2, DVec2, MeshError, StructuredGrid2, TfiParams};
 use crate::{Decomposition, EdgeKind};
 
 /// The curves Q_j of every block side, numbered block by block and side by side (the J_{k,side}
-/// convention of seed 000 §5.2.1), with the cut pairs.
+/// convention of [Méndez 2023, §5.2.1]), with the cut pairs.
 #[derive(Debug, Clone)]
 pub struct BlockCurves {
     /// For each block and side, the curve ids.
@@ -137,7 +138,7 @@ impl BlockCurves {
     }
 
     /// Points on side `s` (0 = bottom … 3 = left) of block `k` for the given curve counts:
-    /// `Σ_{j ∈ J_{k,s}} m_j − s_{k,s} + 1` (junction points counted once, seed 000 (5.5)).
+    /// `Σ_{j ∈ J_{k,s}} m_j − s_{k,s} + 1` (junction points counted once, [Méndez 2023, (5.5)]).
     pub fn side_points(&self, counts: &[usize], k: usize, s: usize) -> usize {
         let side = &self.sides[k][s];
         side.iter().map(|&j| counts[j]).sum::<usize>() + 1 - side.len()

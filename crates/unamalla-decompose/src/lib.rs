@@ -1,6 +1,7 @@
 //! # unamalla-decompose
 //!
-//! Stage 2 and 3a of the pipeline (seed 000 digest §3 and §4.1–4.2, thesis ch. 4 and §5.1):
+//! Stage 2 and 3a of the pipeline ([Méndez 2023, Ch. 4, §5.1, §5.1.1]; the references are listed
+//! in `docs/references.md` of the repository):
 //! decompose a planar region with holes into **admissible blocks** by straight **cuts**, and
 //! choose **four corners** per block, so that every block can be meshed by a structured grid
 //! and neighbouring grids match along whole cuts (no interior singularities).
@@ -25,22 +26,23 @@
 //! ## What a decomposition is
 //!
 //! A [`Decomposition`] has [`Block`]s and [`Cut`]s. A cut is a straight segment between two
-//! boundary points whose open interior lies in the open region (tested exactly with
-//! `orient2d`). Each block is a simple counter-clockwise ring; `edges[i]` says whether ring edge
-//! `i` is original boundary (and of which region ring) or a whole cut (which cut, which
-//! neighbour). Cut endpoints are vertices of both adjacent blocks and every cut is exactly one
-//! edge of each of its two blocks. `corners` are four ring indices in counter-clockwise order
-//! (bottom, right, top, left sides). [`Block::side_curves`] splits each side into the curves Q_j
-//! the compatibility ILP needs (seed 000 digest §4.1). The binary tree T and the adjacency
-//! graph 𝒢 (one independent cycle per hole, [`Decomposition::graph_cycles`]) are available
-//! (§3.3). [`Decomposition::validate`] proves the tiling: cuts inside and disjoint, each cut an
-//! edge of exactly two blocks in opposite directions, every boundary edge covered exactly once
-//! in its own direction, areas adding up — which together imply that the blocks cover the
-//! region without overlap (the boundary chains of the blocks add up to the region's boundary).
+//! boundary points whose open interior lies in the open region (tested exactly with `orient2d`).
+//! Each block is a simple counter-clockwise ring; `edges[i]` says whether ring edge `i` is original
+//! boundary (and of which region ring) or a whole cut (which cut, which neighbour). Cut endpoints
+//! are vertices of both adjacent blocks and every cut is exactly one edge of each of its two
+//! blocks. `corners` are four ring indices in counter-clockwise order (bottom, right, top, left
+//! sides). [`Block::side_curves`] splits each side into the curves Q_j the compatibility ILP needs
+//! ([Méndez 2023, §5.1]). The binary tree T and the adjacency graph 𝒢 (one independent cycle per
+//! hole, [`Decomposition::graph_cycles`]) are available ([Méndez 2023, §4.3]).
+//! [`Decomposition::validate`] proves the tiling: cuts inside and disjoint, each cut an edge of
+//! exactly two blocks in opposite directions, every boundary edge covered exactly once in its own
+//! direction, areas adding up — which together imply that the blocks cover the region without
+//! overlap (the boundary chains of the blocks add up to the region's boundary).
 //!
 //! ## The algorithm (automatic; the thesis was interactive)
 //!
-//! Algorithm 1 (§4.2.1) with **exclusive branches** (errata 12): for a piece
+//! [Méndez 2023, Algorithm 1] (§4.2.1) with **exclusive branches** (the thesis prints three
+//! sequential `if`s; after a split the piece is no longer a leaf): for a piece
 //!
 //! 1. **with holes → Algorithm 2** (hole removal): the shortest admissible bridges between a
 //!    hole and the outer ring (vertex → vertex or vertex → foot of the perpendicular on an edge)
@@ -77,7 +79,7 @@
 //!    up to four times until pq is a valid cut) is cut off and left as a leaf; the triangle
 //!    angles are θ and (180° − θ)/2, the remainder gets 90° + θ/2 at p and q. The triangle must
 //!    have at least `min_triangle_fraction` (10⁻⁵) of the region's area — smaller than the
-//!    negligible area on purpose (issue #6: a critical corner left in a block is worse than a
+//!    negligible area on purpose (a critical corner left in a block is worse than a
 //!    small triangle block; the thesis's Obs 4.5 only warns against small triangles).
 //!
 //! **Validity rules** (§4.2.3): cuts are disjoint (they never cross piece boundaries and end only
@@ -91,7 +93,8 @@
 //! (module [`concavity`](mod@concavity)) plus, beyond the thesis, the **spike criterion**: no
 //! interior angle above θ₊ = 350° (the tip of a sliver island or of a thin spit of the
 //! exterior changes κ₁–κ₃ too little to be noticed, but a block side cannot pass it: its two
-//! cells there would need angles of ≈ 179° each — issue #8's gulf-of-mexico fold). Such tips
+//! cells there would need angles of ≈ 179° each — the fold once seen on the gulf-of-mexico
+//! region). Such tips
 //! are tried first as starts of the concavity cut, whose bisector candidate leaves two angles
 //! ≤ 180° (tested: `tests/known_answers.rs`, `a_spike_tip_gets_a_cut_so_no_block_keeps_it`).
 //! All rankings are geometric; ties are broken by
@@ -118,7 +121,7 @@
 //! block, so a region (or a union of blocks) with fewer than four usable vertices can never be
 //! cut into blocks with four usable corners each — a triangle stays a triangle block.
 //!
-//! **No corner inside a cut** (issue #6, fourth step of the repair): a block that would still
+//! **No corner inside a cut** (fourth step of the repair): a block that would still
 //! need a point inside a cut for the triangle-block rule (bounded by cuts where its corners
 //! must go, fewer than four usable vertices) is split or merged and re-split with a relaxed
 //! acceptance (a critical angle or a non-convex block is accepted, a cut joint is not).
@@ -135,13 +138,13 @@
 //! is an interior mesh node of valence 3 (a singularity) — it does not occur in the fixture
 //! decompositions of `docs/results.md (section "Decomposition results")` unless the table says so.
 //!
-//! **Corners** ([`corners`], seed 000 digest §4.2): the best 4-tuple of vertices with an
+//! **Corners** ([`corners`], [Méndez 2023, §5.1.1]): the best 4-tuple of vertices with an
 //! interior angle below 170° (never a straight or reflex vertex) by `F = ¼Σg(θ) + w_bal·balance + w_turn·straightness`; triangles get
 //! the triangle-block rule (two points inserted near each critical vertex, on its two edges,
 //! at the same distance). Those inserted corners have 180° by construction (the thesis's rule,
 //! Figs 5.3–5.4); they are the only corners at or above 170°.
 //!
-//! ## Layouts: the concavity layout and the chord layout (issue #22)
+//! ## Layouts: the concavity layout and the chord layout
 //!
 //! [`Layout::Concavity`] is the algorithm above alone. On long gulfs, elongated islands and
 //! ragged coasts it places long shore-to-shore cuts and cuts *along* elongated parts (sliver
@@ -175,11 +178,12 @@
 //! T = 0.35, 0.75, 1.5 and meshes the one with the best predicted quality
 //! (`unamalla_core::pipeline::choose_layout`).
 //!
-//! ## Submapping (seed 002)
+//! ## Submapping (Ruiz-Gironés & Sarrate)
 //!
 //! Module [`submap`] is the second strategy: vertex classification by turning angles with the ILP
-//! (6)/(8) repair, virtual edges for holes from a constrained Delaunay triangulation, interval
-//! assignment ILP (3), the integer computational space and cuts from Corner/Reversal nodes until
+//! repair [Ruiz-Gironés & Sarrate, (6), (8)], virtual edges for holes from a constrained Delaunay
+//! triangulation, interval assignment ILP [Ruiz-Gironés & Sarrate, (3)], the integer
+//! computational space and cuts from Corner/Reversal nodes until
 //! every piece is a computational rectangle ([`submap::submap`]); the pieces can be TFI'd and merged
 //! ([`submap::Submapping::block_mesh`]) or viewed as a [`Decomposition`]
 //! ([`submap::Submapping::to_decomposition`]).

@@ -1,5 +1,5 @@
 //! Steps 1–2: turning angles, the angle rule, the necessary condition and the ILP repair
-//! (seed 002 digest §3, §7, §8.4).
+//! ([Ruiz-Gironés & Sarrate, Fig 3, (1), (4), (6), (7), (8)]).
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -9,7 +9,8 @@ use unamalla_mesh::{DVec2, Region};
 use super::{kind_of, Classification, EdgeTag, KindCounts, SubmapError, SumMode, VertexInfo};
 
 /// Turning angle `θ = atan2(t_in × t_out, t_in · t_out)` in `[−π, π)` from the incoming to the
-/// outgoing tangent (digest §3.1 \[derived\]); exactly antiparallel tangents give `−π` (Reversal).
+/// outgoing tangent (our formula for the paper's tangent angle, Fig 3); exactly antiparallel
+/// tangents give `−π` (Reversal), as the paper's range `[−π, π)` implies.
 ///
 /// ```
 /// use unamalla_decompose::submap::turning_angle;
@@ -27,7 +28,8 @@ pub fn turning_angle(t_in: DVec2, t_out: DVec2) -> f64 {
     }
 }
 
-/// Deviation of an angle from the nearest multiple of `π/2` (radians), `dev(θ)` of digest §8.3.
+/// Deviation of an angle from the nearest multiple of `π/2` (radians), `dev(θ)`: our measure of
+/// the paper's "best angles" of a virtual edge.
 pub(crate) fn right_deviation(theta: f64) -> f64 {
     (theta - FRAC_PI_2 * (theta / FRAC_PI_2).round()).abs()
 }
@@ -77,7 +79,8 @@ pub fn prefers_submap(region: &Region, tol_deg: f64) -> bool {
 }
 
 /// Classifies every ring vertex by the angle rule and repairs the labels with ILP (6)/(8) when the
-/// condition of `mode` fails (digest §7 "strategy", §8.5 phases 1–2).
+/// condition of `mode` fails (the paper's strategy: the angle rule first, the ILP only when (1) or
+/// (7) fails).
 pub fn classify_region(region: &Region, mode: SumMode) -> Result<Classification, SubmapError> {
     let holes = region.holes().len();
     let mut vertices = Vec::new();

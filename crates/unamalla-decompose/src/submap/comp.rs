@@ -1,5 +1,5 @@
 //! Steps 4–6: edge classification, interval assignment ILP (3), boundary discretization and the
-//! computational space (seed 002 digest §4, §5, §6.1).
+//! computational space ([Ruiz-Gironés & Sarrate, Fig 4, (2), (3), Fig 5]).
 
 use std::collections::HashMap;
 
@@ -247,7 +247,8 @@ pub(crate) fn build(mut points: Vec<LPoint>, options: &SubmapOptions) -> Result<
     // Reversal) the interior angles of the visits must not overlap. Each visit covers the quarter
     // sectors d_out, d_out + 1, …, d_out + s − 1 (s = interior angle in quarter turns). ILP (3)
     // balances only the global sums (2), so it can place a hole across the outer boundary
-    // (digest §10.10, Fig 11); that shows up here as overlapping sectors.
+    // (a case the paper does not treat; compare its Fig 11); that shows up here as overlapping
+    // sectors.
     let ang = super::cuts::angles(&occurrences);
     let mut seen: HashMap<[i64; 2], (u8, usize)> = HashMap::new();
     for (o, &(d_out, s)) in occurrences.iter().zip(&ang) {

@@ -1,5 +1,6 @@
 //! Step 7: recursive decomposition by cut lines from Corner / Reversal nodes, shortest in
-//! computational space (seed 002 digest §6.2, §10.10).
+//! computational space ([Ruiz-Gironés & Sarrate, Fig 6]; taking the shortest over the whole piece,
+//! the tie-break and the placement of the cut nodes are ours, the paper leaves them open).
 
 use std::collections::HashMap;
 

@@ -1,65 +1,77 @@
-//! # Submapping (seed 002: Ruiz-Gironés & Sarrate, multiply connected surfaces)
+//! # Submapping ([Ruiz-Gironés & Sarrate], multiply connected surfaces)
 //!
-//! A second decomposition strategy next to the cut decomposition of seed 000: the region is split
-//! into pieces that are **rectangles in a computational (index) space**, each piece is filled by
-//! TFI and the pieces are conformal by construction. It applies to regions whose angles are close to
-//! multiples of 90° (mechanical parts, rectilinear plates with holes); fuzzy angles are repaired by
-//! the vertex-classification ILP. The six steps of the paper (digest §2) plus the multiply-connected
-//! conversion (digest §8.5) are:
+//! The references are listed in `docs/references.md` of the repository; the paper is cited by its
+//! equations `(1)`–`(8)` and figures.
 //!
-//! 1. **Vertex classification** ([`classify_region`], digest §3.1). The turning angle at vertex `i`
-//!    of a ring traversed with the domain on the left (outer ring CCW, holes CW — digest §3.1 \[NOTE\],
-//!    erratum §10.1) is
+//! A second decomposition strategy next to the cut decomposition of [Méndez 2023, Ch. 4]: the
+//! region is split into pieces that are **rectangles in a computational (index) space**, each piece
+//! is filled by TFI and the pieces are conformal by construction. It applies to regions whose
+//! angles are close to multiples of 90° (mechanical parts, rectilinear plates with holes); fuzzy
+//! angles are repaired by the vertex-classification ILP. The six steps the paper lists for
+//! submapping plus its conversion of multiply connected domains (the overall strategy of its
+//! section "Dominios no simplemente conexos") are:
+//!
+//! 1. **Vertex classification** ([`classify_region`], [Ruiz-Gironés & Sarrate, Fig 3]). The turning
+//!    angle at vertex `i` of a ring traversed with the domain on the left (outer ring CCW, holes
+//!    CW; the paper never states the orientation, it is the one its angle values and (7) imply) is
 //!    `θ_i = atan2(t_in × t_out, t_in · t_out) ∈ [−π, π)` (exactly antiparallel tangents give `−π`,
 //!    a Reversal), `α_i = θ_i/(π/2)` and the initial label is `round(α_i)` clamped to `{−2,…,1}` =
 //!    {Reversal, Corner, Side, End}.
-//! 2. **Necessary condition** `E − C − 2R = 4(1 − H)` (eq. (1)/(7), digest §3.2, §8.4). When it
-//!    fails, the labels are recomputed by the ILP (6)/(8) of `unamalla-compat-ilp` in the digest's
-//!    Option A reading (`ā_i = α_i` real, `ρ_i = ω_i = 1`). [`SumMode::PerLoop`] (default) imposes
-//!    `Σ_outer α = 4` and `Σ_hole α = −4` separately — the stricter variant the digest §8.4 \[NOTE\]
-//!    recommends offering, because a hole labelled with `Σ = −6` forces a "twisted" computational
-//!    image (Fig 11) that the cut search cannot handle; [`SumMode::Global`] is the paper's (8).
-//! 3. **Virtual edges** (digest §8.3): the rings are discretized at the target size `h`, a
-//!    constrained Delaunay triangulation of those points (plus the feet of the perpendiculars from
-//!    hole vertices onto the other rings' edges, so that exactly axis-aligned return segments
-//!    exist; all points lie on the boundary, no interior Steiner points, as in the paper) gives
-//!    the candidate edges, and among the edges joining the current outer loop to an unconnected
-//!    hole the one with the **best angles** wins. The paper does not quantify "best"; we use the
-//!    digest's recommendation: the four junction turning angles `θ` it creates are scored by
-//!    `dev(θ) = |θ − (π/2)·round(θ/(π/2))|`, ranked by `max dev`, then `Σ dev`, then the edge length
-//!    (the paper's tie-break), then coordinates. Loop surgery:
+//! 2. **Necessary condition** `E − C − 2R = 4(1 − H)` ([Ruiz-Gironés & Sarrate, (1), (7)]). When it
+//!    fails, the labels are recomputed by the ILP [Ruiz-Gironés & Sarrate, (6), (8)] of
+//!    `unamalla-compat-ilp`, reading the paper's "initially detected classification" `ā_i` as the
+//!    real `α_i` with `ρ_i = ω_i = 1` (the paper gives no weights). [`SumMode::PerLoop`] (default)
+//!    imposes `Σ_outer α = 4` and `Σ_hole α = −4` separately — a stricter variant than the paper's,
+//!    which constrains only the global sum; we offer it because a hole labelled with `Σ = −6`
+//!    forces a "twisted" computational image (Fig 11) that the cut search cannot handle;
+//!    [`SumMode::Global`] is the paper's (8).
+//! 3. **Virtual edges** ([Ruiz-Gironés & Sarrate, Fig 8, Fig 10]): the rings are discretized at the
+//!    target size `h`, a constrained Delaunay triangulation of those points (plus the feet of the
+//!    perpendiculars from hole vertices onto the other rings' edges, so that exactly axis-aligned
+//!    return segments exist; all points lie on the boundary, no interior Steiner points, as in the
+//!    paper) gives the candidate edges, and among the edges joining the current outer loop to an
+//!    unconnected hole the one with the **best angles** wins. The paper does not quantify "best";
+//!    our measure: the four junction turning angles `θ` it creates are scored by
+//!    `dev(θ) = |θ − (π/2)·round(θ/(π/2))|`, ranked by `max dev`, then `Σ dev`, then the edge
+//!    length (the paper's tie-break), then coordinates. Loop surgery:
 //!    `outer…A → (A→B) → hole from B around to B → (B→A) → A…outer`. The junction vertices are
 //!    classified by the angle rule and (1) is rechecked on the merged loop; if it fails, ILP (6)
-//!    runs on the merged loop with the ring labels pinned (weight 1000) and the junction labels free
-//!    (digest §10.7).
-//! 4. **Edge classification** (digest §4): the loop's edges are the maximal runs between non-Side
-//!    vertices (a polyline between two non-Side vertices is one "curve"; virtual-edge ends always
-//!    break). Directions in `Z_4` (0 = +i, 1 = +j, 2 = −i, 3 = −j): the first edge is `+i` and
-//!    `d_{k+1} = d_k + α_{v_k} (mod 4)`; the walk must close (`Σ α ≡ 0 mod 4`, and `Σ α = 4`).
-//! 5. **Interval assignment** ILP (3) (digest §5): `min Σ n_e/l(e) + M`, `Σ_{I+} n = Σ_{I−} n`,
-//!    `Σ_{J+} n = Σ_{J−} n`, `N_e M ≥ n_e`, `n_e ≥ N_e = max(1, round(l(e)/h))`, with
-//!    `n_{e'} = n_{e''}` for the two copies of a virtual edge. Nodes are placed uniformly in arc
-//!    length on each edge (digest §6.1 \[NOTE\]); Side vertices that turn by more than
+//!    runs on the merged loop with the ring labels pinned (weight 1000) and the junction labels
+//!    free (the paper does not say how the junction vertices are classified; this rule is ours).
+//! 4. **Edge classification** ([Ruiz-Gironés & Sarrate, Fig 4]): the loop's edges are the maximal
+//!    runs between non-Side vertices (a polyline between two non-Side vertices is one "curve";
+//!    virtual-edge ends always break). Directions in `Z_4` (0 = +i, 1 = +j, 2 = −i, 3 = −j): the
+//!    first edge is `+i` and `d_{k+1} = d_k + α_{v_k} (mod 4)`; the walk must close
+//!    (`Σ α ≡ 0 mod 4`, and `Σ α = 4`).
+//! 5. **Interval assignment** ILP [Ruiz-Gironés & Sarrate, (3)]: `min Σ n_e/l(e) + M`,
+//!    `Σ_{I+} n = Σ_{I−} n`, `Σ_{J+} n = Σ_{J−} n`, `N_e M ≥ n_e`,
+//!    `n_e ≥ N_e = max(1, round(l(e)/h))`, with `n_{e'} = n_{e''}` for the two copies of a virtual
+//!    edge (the paper does not say how `N_e` follows from `h`; the equality is its "generated nodes
+//!    coincide"). Nodes are placed uniformly in arc length on each edge (the paper does not say
+//!    where; our choice); Side vertices that turn by more than
 //!    [`SubmapOptions::keep_vertex_angle_deg`] are kept as nodes (the edge's `N_e` is raised to the
 //!    number of its pieces and the intervals are spread over them in proportion to length).
-//! 6. **Computational space** (digest §6.1): every node gets an integer position, the walk
-//!    `p_{end} = p_{start} + n_e·dir(e)` must return to the origin, and the loop must be weakly
-//!    simple (where a position is visited twice the interior angles of the visits must not
-//!    overlap). ILP (3) balances only the global sums (2), so it can stretch an edge such that a
-//!    hole crosses the outer boundary in computational space (digest §10.10); the virtual edges
-//!    of such an attempt are then banned and the next best ones tried
+//! 6. **Computational space** ([Ruiz-Gironés & Sarrate, Fig 2, Fig 5]): every node gets an integer
+//!    position, the walk `p_{end} = p_{start} + n_e·dir(e)` must return to the origin, and the loop
+//!    must be weakly simple (where a position is visited twice the interior angles of the visits
+//!    must not overlap). ILP (3) balances only the global sums (2), so it can stretch an edge such
+//!    that a hole crosses the outer boundary in computational space (a case the paper does not
+//!    treat; compare its Fig 11, a virtual edge traversed twice in the same direction); the virtual
+//!    edges of such an attempt are then banned and the next best ones tried
 //!    ([`SubmapOptions::max_attempts`]), otherwise [`SubmapError::Overlap`] is returned.
-//! 7. **Cuts** (digest §6.2): from every concave node (interior angle 270° = Corner or 360° =
-//!    Reversal) rays along the axis directions strictly inside its interior angle (2 for a Corner,
-//!    3 for a Reversal) are cast in computational space; a ray ends at the first boundary node it
-//!    reaches from the inside. The **globally shortest** cut of the piece (digest §10.10), ties by
-//!    physical length then node order, splits the piece; cut nodes are placed by linear
-//!    interpolation between the physical end points (digest §10.10) and are free during smoothing.
-//!    Recursion stops when no concave node is left: the piece has exactly four End nodes and is an
-//!    `a × b` computational rectangle with equal counts on opposite sides.
-//! 8. **TFI** per piece ([`Submapping::grids`], discrete Coons TFI of `unamalla-mesh`, digest §6.3)
-//!    and merge ([`Submapping::block_mesh`]). Cut and virtual-edge nodes become interior nodes of
-//!    the merged mesh, so a smoother moves them (digest §8.4 obs. 2).
+//! 7. **Cuts** ([Ruiz-Gironés & Sarrate, Fig 6]): from every concave node (interior angle 270° =
+//!    Corner or 360° = Reversal) rays along the axis directions strictly inside its interior angle
+//!    (2 for a Corner, 3 for a Reversal) are cast in computational space; a ray ends at the first
+//!    boundary node it reaches from the inside. The **globally shortest** cut of the piece, ties by
+//!    physical length then node order, splits the piece (the paper takes the shortest cut line but
+//!    does not say whether per node or per piece, nor how ties are broken); cut nodes are placed by
+//!    linear interpolation between the physical end points (ours; the paper does not say) and are
+//!    free during smoothing. Recursion stops when no concave node is left: the piece has exactly
+//!    four End nodes and is an `a × b` computational rectangle with equal counts on opposite sides.
+//! 8. **TFI** per piece ([`Submapping::grids`], discrete Coons TFI of `unamalla-mesh`; the paper
+//!    gives no TFI formula) and merge ([`Submapping::block_mesh`]). Cut and virtual-edge nodes
+//!    become interior nodes of the merged mesh, so a smoother moves them (the paper's second
+//!    observation on virtual edges: a smoother removes the imperfections they introduce).
 //!
 //! Interior angles in computational space: for a boundary occurrence with incoming direction
 //! `d_in` and outgoing `d_out` (codes in `Z_4`), `s = (d_in + 2 − d_out) mod 4` (0 read as 4) is the
@@ -70,7 +82,7 @@
 //! use unamalla_decompose::submap::{submap, SubmapOptions};
 //! use unamalla_mesh::{DVec2, Region};
 //!
-//! // L-shape (digest §9.2 T3): E = 5, C = 1; one cut splits it into two rectangles
+//! // L-shape (`shapes::l_shape`): E = 5, C = 1; one cut splits it into two rectangles
 //! let pts = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)];
 //! let region = Region::new(pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect(), vec![])?;
 //! let s = submap(&region, &SubmapOptions::new(0.5))?;
@@ -99,7 +111,8 @@ pub use white::{white_submap, WhiteStep, WhiteSubmapping};
 /// How the necessary condition is imposed when the vertex labels are repaired.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SumMode {
-    /// `Σ α = 4` on the outer ring and `Σ α = −4` on every hole (default; digest §8.4 \[NOTE\]).
+    /// `Σ α = 4` on the outer ring and `Σ α = −4` on every hole (default; stricter than the
+    /// paper's (8), which constrains only the global sum).
     #[default]
     PerLoop,
     /// The paper's (8): only the global sum `Σ α = 4(1 − H)` is imposed.
@@ -322,7 +335,8 @@ impl Classification {
     }
 }
 
-/// A virtual edge (return segment) joining a hole to the outer loop (digest §8.3).
+/// A virtual edge (return segment) joining a hole to the outer loop ([Ruiz-Gironés & Sarrate,
+/// Fig 8, Fig 10]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VirtualEdge {
     /// End on the current outer loop.
@@ -377,7 +391,7 @@ pub enum NodeKind {
     Cut,
 }
 
-/// A cut line made by the decomposition (digest §6.2).
+/// A cut line made by the decomposition ([Ruiz-Gironés & Sarrate, Fig 6]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CutLine {
     /// Node ids from the concave start node to the end node.

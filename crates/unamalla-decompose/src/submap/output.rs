@@ -17,8 +17,8 @@ impl Submapping {
             .map(|s| s.iter().map(|&id| self.nodes[id]).collect())
     }
 
-    /// One structured grid per piece by discrete Coons TFI with arc-length parameters
-    /// (digest §6.3 \[NOTE\]).
+    /// One structured grid per piece by discrete Coons TFI with arc-length parameters (the paper
+    /// gives no TFI formula; this is the standard one).
     pub fn grids(&self) -> Result<Vec<StructuredGrid2>, SubmapError> {
         (0..self.pieces.len())
             .map(|k| {

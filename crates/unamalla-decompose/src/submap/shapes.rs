@@ -1,14 +1,14 @@
-//! Exact synthetic test geometries for submapping — the seed 002 digest §9.2 stand-ins for the
-//! paper's figures, which come without coordinates. Used by the tests, the comparison example of
-//! `unamalla-core` and the GeoJSON files in `fixtures/synthetic/`.
+//! Exact synthetic test geometries for submapping — our stand-ins for the figures of
+//! [Ruiz-Gironés & Sarrate], which come without coordinates. Used by the tests, the comparison
+//! example of `unamalla-core` and the GeoJSON files in `fixtures/synthetic/`.
 //!
 //! | name | stand-in for | expected labels (outer; holes) |
 //! |---|---|---|
-//! | `l-shape` | digest T3 | E = 5, C = 1 |
-//! | `u-shape` | digest T4 | E = 6, C = 2 |
+//! | `l-shape` | (the simplest case with one Corner) | E = 5, C = 1 |
+//! | `u-shape` | (two Corners) | E = 6, C = 2 |
 //! | `u-slot` | Ex 2 / Fig 14 (one Reversal) | E = 6, R = 1 |
-//! | `square-hole` | T7 / Fig 8 | E = 4; C = 4 |
-//! | `plate-3-holes` | T8 / Fig 10, Fig 17 | E = 4; C = 4 per hole |
+//! | `square-hole` | Fig 8 | E = 4; C = 4 |
+//! | `plate-3-holes` | Fig 10, Fig 17 | E = 4; C = 4 per hole |
 //! | `half-nut` | Ex 1 / Fig 13 | rule gives E = 7, ILP (6) → E = 4 |
 //! | `mechanical-part` | Ex 4 / Fig 15b + a hole (Ex 6) | rule gives E − C = 5, ILP (6) → E = 5, C = 1; C = 4 |
 

@@ -1,5 +1,6 @@
 //! Step 3: virtual edges from a constrained Delaunay triangulation of the boundary discretization
-//! and loop surgery (seed 002 digest §8.3, §8.4, §10.7–10.9).
+//! and loop surgery ([Ruiz-Gironés & Sarrate, Fig 8, Fig 10, (7)]; the angle score, the labels of
+//! the junction vertices and the recheck of (1) on the merged loop are ours).
 
 use std::f64::consts::FRAC_PI_2;
 
@@ -109,8 +110,8 @@ fn better(a: &Score, b: &Score) -> bool {
     a.3 < b.3
 }
 
-/// Joins every hole to the outer loop by virtual edges (digest §8.3 phases 1–4) and relabels the
-/// junction vertices (angle rule, then ILP (6) on the merged loop if (1) fails).
+/// Joins every hole to the outer loop by virtual edges (the paper's four phases, Fig 10) and
+/// relabels the junction vertices (angle rule, then ILP (6) on the merged loop if (1) fails).
 pub(crate) fn connect(
     region: &Region,
     mut rings: Vec<Vec<LPoint>>,
@@ -348,7 +349,8 @@ fn splice(
 }
 
 /// Junction labels by the angle rule, then (1) on the merged loop: if `Σ label ≠ 4`, ILP (6)
-/// relabels the junctions with the ring labels pinned (weight 1000; digest §10.7). Returns
+/// relabels the junctions with the ring labels pinned (weight 1000; our rule, the paper does not
+/// say how the junctions are classified). Returns
 /// whether the ILP ran.
 fn label_junctions(current: &mut [LPoint]) -> Result<bool, SubmapError> {
     let n = current.len();
