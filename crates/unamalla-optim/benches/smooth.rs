@@ -1,5 +1,5 @@
 //! Criterion benchmark: untangle + smooth ((6.8), ε = 0.01) the TFI grid of the sinusoidal
-//! four-sided region (sample size 10), with the tolerance of `examples/large_grid.rs`
+//! four-sided region (sample size 10), with the tolerance of `studies/large_grid.rs`
 //! (FTOL 1e-9, GTOL off, MAXITER 500; the same for every size).
 //!
 //! * `smooth_sinusoidal/<solver>/<n>`: each solver from the TFI grid at 100² and 301² nodes

@@ -3,7 +3,7 @@
 //! in `docs/references.md` of the repository) and prints the Markdown table of
 //! `docs/benchmarks.md`.
 //!
-//! `cargo run --release -p unamalla-optim --example fixtures_table`
+//! `cargo run --release -p unamalla-optim --example options_table`
 //!
 //! With the argument `options` it prints instead the table of the options added for the
 //! source's remaining rows (docs/results.md, section "González Flores options: homotopy paths,
