@@ -1,4 +1,4 @@
-//! The automatic decomposition: Algorithm 1 driving Algorithms 2–4 (seed 000 digest §3.2),
+//! The automatic decomposition: Algorithm 1 driving Algorithms 2–4 ([Méndez 2023, §4.2.1]),
 //! with the cut score documented in the crate root, and the assembly of the final blocks.
 
 use std::collections::HashMap;

@@ -422,7 +422,7 @@ impl PieceTree {
 /// The **neck score** of a simple polygon (a block): the largest `min(A₁, A₂)/w²` over its
 /// chords (module docs) — how many chord widths the smaller side extends beyond its
 /// narrowest chord. A convex, roughly square block scores ≤ ½; a block that keeps a narrow arm
-/// or a long tongue scores high. Used by the category tests of issue #22.
+/// or a long tongue scores high. Used by the shape-category tests (`unamalla-core/tests/categories.rs`).
 pub fn neck_score(ring: &[DVec2]) -> f64 {
     let Ok(region) = Region::new(ring.to_vec(), vec![]) else {
         return f64::NAN;

@@ -1,5 +1,5 @@
 //! Concavity measures κ₁–κ₄, bridges and pockets, critical angles and the admissible-region
-//! test (seed 000 digest §3.1 and §3.4; thesis §4.1, §4.4).
+//! test ([Méndez 2023, §4.1, §4.4]).
 //!
 //! For a simple counter-clockwise ring Ω with convex hull 𝒞:
 //!
@@ -9,7 +9,7 @@
 //!   polygon vertices strictly between the bridge's endpoints;
 //! * κ₃(p) = distance from p to its bridge segment, with Ω rescaled so that its circumscribing
 //!   circle has radius 1 — we use the radius R = diam(𝒞)/2 (half the hull diameter; the exact
-//!   minimal enclosing circle lies between diam/2 and diam/√3, the digest leaves the choice open);
+//!   minimal enclosing circle lies between diam/2 and diam/√3, and the thesis does not say which it uses);
 //! * κ₄(p) = arc length along the pocket from p to the nearer bridge endpoint, divided by
 //!   perimeter(Ω) (Ω rescaled to perimeter 1);
 //! * κᵢ(β) = max over the pocket, κᵢ(Ω) = max over bridges (0 for a convex ring).

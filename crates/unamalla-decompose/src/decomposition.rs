@@ -1,5 +1,5 @@
 //! The result of the stage: blocks with their rings, edge bookkeeping and corners, the cuts,
-//! the binary decomposition tree and the block adjacency graph (seed 000 digest §3.3, §4.1).
+//! the binary decomposition tree and the block adjacency graph ([Méndez 2023, §4.3, §5.1]).
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -37,12 +37,12 @@ pub struct Block {
     /// The boundary, counter-clockwise, open. Every cut endpoint on it is a vertex.
     pub ring: Vec<DVec2>,
     /// The four corners as indices into `ring`, in counter-clockwise order: the sides are
-    /// bottom = `corners[0] → corners[1]`, right, top, left (seed 000 digest §4.1).
+    /// bottom = `corners[0] → corners[1]`, right, top, left ([Méndez 2023, §5.1]).
     pub corners: [usize; 4],
     /// Per ring edge: original boundary or cut (`edges.len() == ring.len()`).
     pub edges: Vec<EdgeKind>,
     /// `true` if the block is a triangle whose corners follow the triangle-block rule
-    /// (points inserted near critical vertices, seed 000 digest §4.2).
+    /// (points inserted near critical vertices, [Méndez 2023, §5.1.1]).
     pub triangle: bool,
 }
 
@@ -79,7 +79,7 @@ pub enum Step {
     CornerRepair,
 }
 
-/// A node of the binary decomposition tree T (seed 000 digest §3.3).
+/// A node of the binary decomposition tree T ([Méndez 2023, §4.3]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TreeNode {
     /// Path label: "" for the root, then "1"/"2" per level joined by dots (thesis Fig 4.24).
@@ -112,7 +112,7 @@ impl TreeNode {
 }
 
 /// A maximal piece Q_j of a block side: one whole cut, or a run of original boundary between
-/// corners / cut endpoints (seed 000 digest §4.1).
+/// corners / cut endpoints ([Méndez 2023, §5.1]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SideCurve {
     /// The points, in the block's counter-clockwise order (first and last are corners or cut
@@ -295,7 +295,7 @@ impl Decomposition {
         (edges + comps).saturating_sub(n)
     }
 
-    /// `true` if block `id` is admissible (seed 000 digest §3.1): approximately convex by the
+    /// `true` if block `id` is admissible ([Méndez 2023, §4.1]): approximately convex by the
     /// concavity criteria and, unless it is a triangle block, without critical angles.
     pub fn block_admissible(&self, id: usize, tol: &crate::concavity::Tolerances) -> bool {
         let b = &self.blocks[id];
@@ -310,7 +310,7 @@ impl Decomposition {
     /// In a decomposition without joints every cut ends on the region boundary, so the
     /// blocks' structured grids meet along whole cuts and every interior mesh node has
     /// valence 4. A joint is where a cut was split by the triangle-block rule (a corner placed
-    /// inside a cut, issue #6): one block has a corner there while its neighbour sees a
+    /// inside a cut): one block has a corner there while its neighbour sees a
     /// straight side, and the merged mesh gets an interior node of valence 3 and one of
     /// valence 5. The automatic decomposition avoids them (module `repair`); an empty result
     /// is the check for "no corner strictly inside a cut".

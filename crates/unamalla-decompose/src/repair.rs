@@ -1,4 +1,4 @@
-//! Corner repair: every block must have four **usable corners** (issue #6, beyond the thesis).
+//! Corner repair: every block must have four **usable corners** (our addition: the thesis does not repair corners).
 //!
 //! A usable corner is a block vertex with interior angle θ < θ_lim (default 170°,
 //! [`CornerWeights::corner_angle_limit`](crate::CornerWeights)); module [`corners`](crate::corners)
@@ -19,7 +19,7 @@
 //!    endpoints) when the union is good, or **a merge followed by a split** of the union into two
 //!    good blocks (this moves the shared cut so that it meets the boundary at a better angle).
 //!
-//! 3. **a re-split by two cuts** (issue #6, for the critical angles that relaxed-tier cuts
+//! 3. **a re-split by two cuts** (for the critical angles that relaxed-tier cuts
 //!    leave where they meet a channel's far shore or another cut): the block alone or its union
 //!    with one neighbour is split into **three** good blocks — a first cut leaves one good
 //!    child, the best second cut splits the other into two (`Builder::best_split3`) — or, only
@@ -37,9 +37,9 @@
 //! merged block alone scores `F(U)`); the lowest S wins, ties broken by coordinates. User cuts from
 //! a file are never removed. Blocks that stay without four usable corners (three-vertex blocks:
 //! a triangle cannot be split into quadrilaterals by straight cuts without an interior node of
-//! valence 3) get the triangle-block rule of seed 000 digest §4.2 afterwards.
+//! valence 3) get the triangle-block rule of [Méndez 2023, §5.1.1] afterwards.
 //!
-//! 4. **No corner inside a cut** (issue #6, `Builder::joint_pass`): a block that is bounded by
+//! 4. **No corner inside a cut** (`Builder::joint_pass`): a block that is bounded by
 //!    cuts on the sides where it would need corners and has fewer than four usable vertices
 //!    (maryland's "block 4" at the pipeline defaults: a quadrilateral of four cuts with a
 //!    reflex vertex and a 30° vertex) could only get the triangle-block rule by inserting points
@@ -668,7 +668,7 @@ impl Builder<'_> {
             Self::targets_on_ring(&piece, 0, p, &near, &mut t);
             // also the quarter points of the original-boundary edges: a cut that met the
             // boundary at a critical angle at a vertex can end inside the edge instead, where
-            // the foot of the perpendicular is not on the edge (issue #6)
+            // the foot of the perpendicular is not on the edge
             for e in (0..n).filter(|_| quarter_points) {
                 let e2 = (e + 1) % n;
                 if near(e) || near(e2) || !matches!(ring.tags[e], Tag::Boundary(_)) {
@@ -1116,7 +1116,7 @@ impl Builder<'_> {
         }
     }
 
-    /// Step 4 of the repair (issue #6): every block that would still get a corner inside a
+    /// Step 4 of the repair: every block that would still get a corner inside a
     /// cut (a cut joint: a block bounded by cuts without four usable corners, whose
     /// triangle-block rule cannot insert on the original boundary) is split, or merged with a
     /// neighbour (and the union re-split), into blocks that take their corners without one —
@@ -1536,7 +1536,7 @@ mod tests {
     #[test]
     fn triangle_of_cuts_gets_no_corner_inside_a_cut() {
         // 10 × 10 square cut by the triangle of cuts P = (5,0), Q = (10,6), R = (0,6) (the
-        // maryland situation of issue #6: a piece bounded by cuts only). Its angles are
+        // situation once seen on maryland: a piece bounded by cuts only). Its angles are
         // 2·atan(5/6) = 79.6° at P and atan(6/5) = 50.2° at Q and R (no critical angle), so the
         // triangle-block rule would put its fourth corner at the midpoint of its longest side —
         // inside a cut (a valence-3 node in the mesh). The joint pass must merge it away.
