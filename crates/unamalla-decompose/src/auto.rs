@@ -898,7 +898,7 @@ impl<'a> Builder<'a> {
 
     /// The two new angles at a cut end going towards `target`: (angle on the side of the
     /// outgoing edge, angle on the side of the incoming edge).
-    fn end_angles(piece: &Piece, e: End, target: DVec2) -> (f64, f64) {
+    pub(crate) fn end_angles(piece: &Piece, e: End, target: DVec2) -> (f64, f64) {
         let (prev, cur, next) = piece.chain(e);
         (left_angle(target, cur, next), left_angle(prev, cur, target))
     }
@@ -914,25 +914,37 @@ impl<'a> Builder<'a> {
         e2: End,
         tier: usize,
     ) -> Option<(f64, f64)> {
+        if self.screened_out(piece, e1, e2, tier) {
+            return None;
+        }
+        let (p, q) = (piece.point(e1), piece.point(e2));
+        let (a, b) = Self::end_angles(piece, e1, q);
+        let (c, d) = Self::end_angles(piece, e2, p);
+        self.angle_terms_of([a, b, c, d], tier)
+    }
+
+    /// Whether [`AngleScreen`] rejects the candidate cut from `e1` to `e2` in `tier`: a new
+    /// angle surely below the tier's limit, or in tier 0 a reflex angle at `e1` — decisions
+    /// that [`Builder::angle_terms_of`] would reach from the `atan2` angles (exact, see the
+    /// screen), so [`Builder::angle_terms`] returns `None` without computing them.
+    pub(crate) fn screened_out(&self, piece: &Piece, e1: End, e2: End, tier: usize) -> bool {
         let p = piece.point(e1);
         let q = piece.point(e2);
-        // the candidates that a new angle surely below the limit (or, in tier 0, a reflex
-        // angle at `e1`) rejects are rejected before any `atan2` (exact: AngleScreen)
         let screen = &self.screens[tier.saturating_sub(1).min(2)];
         let (prev1, _, next1) = piece.chain(e1);
         let (prev2, _, next2) = piece.chain(e2);
-        if screen.surely_below(q, p, next1)
+        screen.surely_below(q, p, next1)
             || screen.surely_below(prev1, p, q)
             || screen.surely_below(p, q, next2)
             || screen.surely_below(prev2, q, p)
             || (tier == 0
                 && (AngleScreen::surely_reflex(q, p, next1)
                     || AngleScreen::surely_reflex(prev1, p, q)))
-        {
-            return None;
-        }
-        let (a, b) = Self::end_angles(piece, e1, q);
-        let (c, d) = Self::end_angles(piece, e2, p);
+    }
+
+    /// [`Builder::angle_terms`] from the four new angles: `a`, `b` at the first end (as
+    /// [`Builder::end_angles`] gives them towards the second end), `c`, `d` at the second.
+    pub(crate) fn angle_terms_of(&self, [a, b, c, d]: [f64; 4], tier: usize) -> Option<(f64, f64)> {
         let min = a.min(b).min(c).min(d);
         let theta = self.opts.tolerances.theta_minus;
         let limit = match tier {

@@ -54,6 +54,7 @@
 //!    lists the joints that remain (none on the fixture regions, tested).
 
 use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 use unamalla_mesh::DVec2;
@@ -63,7 +64,7 @@ use crate::concavity::{concavity, concavity_with_angles, critical_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
-use crate::geom::{ring_angles, visit_sorted};
+use crate::geom::{left_angle, match_vertices, ring_angles, visit_sorted};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
@@ -401,6 +402,131 @@ impl Host {
     }
 }
 
+/// The new angles at the ends of the candidate cuts of one host ring — at a vertex towards
+/// the cut's other end, and at the foot of a perpendicular from a vertex towards that
+/// vertex, as [`Builder::end_angles`] computes them — each computed once for the split
+/// searches of the host and of its children (the second cuts of a re-split,
+/// [`Builder::best_split3`], search children of the host again and again).
+///
+/// Exact: a child's vertex that has the host vertex's point and neighbours, bit for bit,
+/// has the same angles towards the same point (the same `atan2` on the same numbers); a
+/// child's edge with a host edge's end points has the same foot of the perpendicular from
+/// the same point (`targets_on_ring` computes it from those three points alone), and the
+/// same angles there. [`EndAngles::locate`] finds those vertices and edges.
+struct EndAngles<'a> {
+    host: &'a [DVec2],
+    /// `[i·n + j]`: the two angles at host vertex `i` towards host vertex `j`, as bits;
+    /// 0 while not computed (an angle is in (0, 2π] or NaN, never +0.0).
+    to_vertex: Vec<[AtomicU64; 2]>,
+    /// `[i·n + e]`: the two angles at host vertex `i` towards the foot of its perpendicular
+    /// on host edge `e`, then the two at that foot towards vertex `i`.
+    to_foot: Vec<[AtomicU64; 4]>,
+}
+
+/// Where the vertices and edges of a ring are those of an [`EndAngles`] host: host vertex
+/// of each ring vertex with the same point and neighbours, host edge of each ring edge with
+/// the same end points (`usize::MAX`: none).
+struct HostMatch {
+    vertex: Vec<usize>,
+    edge: Vec<usize>,
+}
+
+impl<'a> EndAngles<'a> {
+    /// An empty table of `host`'s angles.
+    fn new(host: &'a [DVec2]) -> Self {
+        let n2 = host.len() * host.len();
+        Self {
+            host,
+            to_vertex: (0..n2).map(|_| Default::default()).collect(),
+            to_foot: (0..n2).map(|_| Default::default()).collect(),
+        }
+    }
+
+    /// The vertices and edges of `ring` that are the host's (see [`HostMatch`]).
+    fn locate(&self, ring: &Ring) -> HostMatch {
+        let (n, m) = (ring.len(), self.host.len());
+        let same =
+            |a: DVec2, b: DVec2| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits();
+        // match from the host vertex of the ring's first point (or second, when the first
+        // is a point inserted by a cut)
+        let start = ring
+            .pts
+            .iter()
+            .take(2)
+            .find_map(|&p| self.host.iter().position(|&h| same(h, p)))
+            .unwrap_or(0);
+        let map = match_vertices(&ring.pts, self.host, start);
+        let vertex = (0..n)
+            .map(|k| {
+                let j = map[k];
+                let kept = j != usize::MAX
+                    && same(self.host[(j + m - 1) % m], ring.prev(k))
+                    && same(self.host[(j + 1) % m], ring.next(k));
+                if kept {
+                    j
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
+        let edge = (0..n)
+            .map(|k| {
+                let (j, l) = (map[k], map[(k + 1) % n]);
+                if j != usize::MAX && l == (j + 1) % m {
+                    j
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
+        HostMatch { vertex, edge }
+    }
+
+    /// Reads the angles stored at `slot`, or stores and returns those `compute` gives.
+    fn cached<const K: usize>(
+        slot: &[AtomicU64; K],
+        compute: impl FnOnce() -> [f64; K],
+    ) -> [f64; K] {
+        let bits = slot.each_ref().map(|a| a.load(Ordering::Relaxed));
+        if bits.iter().all(|&b| b != 0) {
+            return bits.map(f64::from_bits);
+        }
+        // another thread may compute the same angles at the same time: the same values
+        let v = compute();
+        for (a, x) in slot.iter().zip(v) {
+            a.store(x.to_bits(), Ordering::Relaxed);
+        }
+        v
+    }
+
+    /// The angles at host vertex `i` towards host vertex `j`.
+    fn vertex_angles(&self, i: usize, j: usize) -> [f64; 2] {
+        let h = self.host;
+        let n = h.len();
+        Self::cached(&self.to_vertex[i * n + j], || {
+            let (prev, p, next, q) = (h[(i + n - 1) % n], h[i], h[(i + 1) % n], h[j]);
+            [left_angle(q, p, next), left_angle(prev, p, q)]
+        })
+    }
+
+    /// The angles at host vertex `i` towards `x`, the foot of its perpendicular on host edge
+    /// `e`, then at `x` towards vertex `i`.
+    fn foot_angles(&self, i: usize, e: usize, x: DVec2) -> [f64; 4] {
+        let h = self.host;
+        let n = h.len();
+        Self::cached(&self.to_foot[i * n + e], || {
+            let (prev, p, next) = (h[(i + n - 1) % n], h[i], h[(i + 1) % n]);
+            let (a, b) = (h[e], h[(e + 1) % n]);
+            [
+                left_angle(x, p, next),
+                left_angle(prev, p, x),
+                left_angle(p, x, b),
+                left_angle(a, x, p),
+            ]
+        })
+    }
+}
+
 /// A screen of the children of the candidate cuts of one ring ([`Builder::for_each_split`]),
 /// from the ring's vertex angles: a child cannot be good ([`Builder::good_fit`]) if it has
 /// fewer than four vertices, or if a vertex whose two neighbours it keeps (so that its
@@ -552,7 +678,7 @@ impl Builder<'_> {
 
     /// The best cut splitting `ring` into two good blocks.
     fn best_split(&self, ring: &Ring) -> Option<Split> {
-        self.best_split_by(ring, &|r: &Ring| self.good_fit(r), true)
+        self.best_split_by(ring, &|r: &Ring| self.good_fit(r), true, None)
     }
 
     /// The best cut splitting `ring` into two blocks that `accept` takes; `accept` returns the
@@ -565,18 +691,20 @@ impl Builder<'_> {
     ///
     /// `good_only` says that `accept` takes only good blocks ([`Builder::good_fit`], possibly
     /// narrowed): then candidates whose children cannot both be good are not built
-    /// ([`Builder::for_each_split`]); it changes no result.
+    /// ([`Builder::for_each_split`]); it changes no result. `angles`: the [`EndAngles`] of a
+    /// ring that `ring` is a child of (or `ring` itself), if the caller keeps one.
     fn best_split_by(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
+        angles: Option<&EndAngles>,
     ) -> Option<Split> {
-        self.best_split_with(ring, accept, good_only, false)
+        self.best_split_with(ring, accept, good_only, false, angles)
             .or_else(|| {
                 self.opts
                     .edge_point_cuts
-                    .then(|| self.best_split_with(ring, accept, good_only, true))
+                    .then(|| self.best_split_with(ring, accept, good_only, true, angles))
                     .flatten()
             })
     }
@@ -588,6 +716,7 @@ impl Builder<'_> {
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
         quarter_points: bool,
+        angles: Option<&EndAngles>,
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
         let need = if good_only { 2 } else { 0 };
@@ -599,6 +728,7 @@ impl Builder<'_> {
             quarter_points,
             need,
             Some(&bound),
+            angles,
             &mut |pre, a, b, ends| {
                 // `accept` is pure: the second child is not looked at when the first fails
                 let Some(fa) = accept(&a) else { return };
@@ -627,13 +757,15 @@ impl Builder<'_> {
     /// With a `bound` (the caller's best two-child score so far, NaN while there is none),
     /// the search ends at the first candidate whose `pre` reaches it: the caller keeps a
     /// candidate only if it scores below the bound, which no candidate from there on can
-    /// (`beyond_best`).
+    /// (`beyond_best`). With `angles`, the new angles at the ends of a cut (without the
+    /// quarter points) come from that table where `ring`'s vertices and edges are its host's.
     fn for_each_split(
         &self,
         ring: &Ring,
         quarter_points: bool,
         need: usize,
         bound: Option<&Cell<f64>>,
+        angles: Option<&EndAngles>,
         visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
     ) {
         let n = ring.len();
@@ -655,6 +787,43 @@ impl Builder<'_> {
         let sq = piece.area().abs().sqrt().max(1e-300);
         let w = self.opts.cut_weights;
         let mut cands: Vec<(f64, End, End)> = Vec::new();
+        let table = angles
+            .filter(|_| !quarter_points)
+            .map(|t| (t, t.locate(ring)));
+        // the angle terms of the cut from vertex `i` (as `angle_terms` in tier 1), from the
+        // table where it has the angles
+        let terms = |i: usize, e2: End| {
+            let from_table = table.as_ref().and_then(|(t, at)| {
+                let hi = at.vertex[i];
+                if hi == usize::MAX {
+                    return None;
+                }
+                match e2.pos {
+                    Pos::Vertex(j) if at.vertex[j] != usize::MAX => {
+                        let hj = at.vertex[j];
+                        Some((hi, None, hj))
+                    }
+                    Pos::OnEdge(e, x) if at.edge[e] != usize::MAX => {
+                        Some((hi, Some(x), at.edge[e]))
+                    }
+                    _ => None,
+                }
+                .map(|(hi, foot, h2)| (t, hi, foot, h2))
+            });
+            let e1 = End {
+                ring: 0,
+                pos: Pos::Vertex(i),
+            };
+            match from_table {
+                None => self.angle_terms(&piece, e1, e2, 1),
+                Some(_) if self.screened_out(&piece, e1, e2, 1) => None,
+                Some((t, hi, None, hj)) => {
+                    let ([a, b], [c, d]) = (t.vertex_angles(hi, hj), t.vertex_angles(hj, hi));
+                    self.angle_terms_of([a, b, c, d], 1)
+                }
+                Some((t, hi, Some(x), he)) => self.angle_terms_of(t.foot_angles(hi, he, x), 1),
+            }
+        };
         // the target list, reused for every start vertex
         let mut t = Vec::new();
         for i in 0..n {
@@ -688,7 +857,7 @@ impl Builder<'_> {
                         continue; // each vertex pair once
                     }
                 }
-                let Some((pen, _)) = self.angle_terms(&piece, e1, e2, 1) else {
+                let Some((pen, _)) = terms(i, e2) else {
                     continue;
                 };
                 let q = piece.point(e2);
@@ -743,11 +912,15 @@ impl Builder<'_> {
     /// `½·max(F₁, F₂, F₃) + (F₁ + F₂ + F₃)/6 + pre₁ + pre₂` — the two-child score
     /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
     /// `good_only` as in [`Builder::best_split_by`].
+    ///
+    /// `angles` is the [`EndAngles`] table of `ring`, shared by the search of the first cuts
+    /// and the searches of the second cuts in their children.
     fn best_split3(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
+        angles: &EndAngles,
     ) -> Option<Resplit> {
         let mut best: Option<Resplit> = None;
         for quarter_points in [false, true] {
@@ -764,6 +937,7 @@ impl Builder<'_> {
                 quarter_points,
                 need,
                 None,
+                Some(angles),
                 &mut |pre1, a, b, ends1| {
                     firsts.push((pre1, a, b, ends1));
                 },
@@ -778,7 +952,7 @@ impl Builder<'_> {
                         _ => return None,
                     };
                     let (s2, r1, r2, ends2) =
-                        self.best_split_by(&as_first_cut(rest), accept, good_only)?;
+                        self.best_split_by(&as_first_cut(rest), accept, good_only, Some(angles))?;
                     let (f1, f2) = (accept(&r1)?, accept(&r2)?);
                     let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
                     let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
@@ -875,7 +1049,7 @@ impl Builder<'_> {
             .map(|(_, _, u)| match accept(u) {
                 Some(cost) => Some((cost, None)),
                 None => self
-                    .best_split_by(u, accept, good_only)
+                    .best_split_by(u, accept, good_only, None)
                     .map(|s| (s.0, Some(s))),
             })
             .collect();
@@ -982,12 +1156,13 @@ impl Builder<'_> {
                 limit
             };
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
+            let angles = EndAngles::new(&u.pts);
             let two = matches!(host, Host::Merged2 { .. })
-                .then(|| self.best_split_by(u, &good, true))
+                .then(|| self.best_split_by(u, &good, true, Some(&angles)))
                 .flatten()
                 .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
             two.into_iter()
-                .chain(self.best_split3(u, &good, true))
+                .chain(self.best_split3(u, &good, true, &angles))
                 .collect()
         };
         // the lowest score wins, candidates compared in host order (as a sequential loop
@@ -1147,7 +1322,7 @@ impl Builder<'_> {
             }
             budget -= 1;
             let relaxed = |u: &Ring| self.relaxed_cost(u);
-            let alone = self.best_split_by(&r, &relaxed, false);
+            let alone = self.best_split_by(&r, &relaxed, false, None);
             let merge = self.best_merge(slot, k, alive, &relaxed, false);
             match (alone, merge) {
                 (Some(s), m) if m.as_ref().is_none_or(|m| s.0 <= m.0) => {
@@ -1474,6 +1649,80 @@ mod tests {
         for &(p, q) in &b.cuts {
             assert!((p.distance(q) - 1.0).abs() < 1e-12, "{p:?}–{q:?}");
         }
+    }
+
+    /// Where `EndAngles::locate` matches a child's vertices and edges to the host's, the
+    /// table's angles are `Builder::end_angles` on the child, bit for bit.
+    #[test]
+    fn end_angle_table_matches_the_child_angles() {
+        let mut state = 0x5eed_1234_abcd_0001u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let bits = |a: [f64; 2]| a.map(f64::to_bits);
+        let mut checked = 0;
+        for _ in 0..200 {
+            let n = 6 + (next() * 30.0) as usize;
+            let pts: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * (i as f64 + 0.5 * next()) / n as f64;
+                    let r = 0.5 + next();
+                    v(r * t.cos(), r * t.sin())
+                })
+                .collect();
+            let host = ring(
+                &pts.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>(),
+                &vec![B; n],
+            );
+            let table = EndAngles::new(&host.pts);
+            // a child: the host from vertex i on, closed by a cut to a point inside an edge
+            let i = (next() * n as f64) as usize % n;
+            let len = 3 + (next() * (n - 4) as f64) as usize;
+            let mut child: Vec<DVec2> = (0..len).map(|k| host.pts[(i + k) % n]).collect();
+            let (a, b) = (host.pts[(i + len - 1) % n], host.pts[(i + len) % n]);
+            child.push(a + 0.5 * (b - a));
+            let child = Ring {
+                tags: vec![B; child.len()],
+                pts: child,
+            };
+            let at = table.locate(&child);
+            let piece = Piece {
+                outer: child.clone(),
+                holes: Vec::new(),
+            };
+            let m = child.len();
+            for k in (0..m).filter(|&k| at.vertex[k] != usize::MAX) {
+                let e1 = End {
+                    ring: 0,
+                    pos: Pos::Vertex(k),
+                };
+                for l in (0..m).filter(|&l| l != k && at.vertex[l] != usize::MAX) {
+                    let q = child.pts[l];
+                    let (x, y) = Builder::end_angles(&piece, e1, q);
+                    assert_eq!(
+                        bits(table.vertex_angles(at.vertex[k], at.vertex[l])),
+                        bits([x, y])
+                    );
+                    checked += 1;
+                }
+                for e in (0..m).filter(|&e| at.edge[e] != usize::MAX) {
+                    let (a, b) = (child.p(e), child.next(e));
+                    let x = a + crate::geom::project_t(child.pts[k], a, b) * (b - a);
+                    let (p0, p1) = Builder::end_angles(&piece, e1, x);
+                    let e2 = End {
+                        ring: 0,
+                        pos: Pos::OnEdge(e, x),
+                    };
+                    let (f0, f1) = Builder::end_angles(&piece, e2, child.pts[k]);
+                    let got = table.foot_angles(at.vertex[k], at.edge[e], x);
+                    assert_eq!(got.map(f64::to_bits), [p0, p1, f0, f1].map(f64::to_bits));
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked}");
     }
 
     #[test]
