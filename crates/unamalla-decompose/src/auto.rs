@@ -511,7 +511,7 @@ pub(crate) struct Builder<'a> {
 /// `fl(y/x) > 10⁻⁶` (the true `atan2(y, x)` = −π + atan(y/x) is at least −π + 10⁻⁶·(1 − 10⁻⁶),
 /// so the computed angle, `atan2 + 2π`, is above π + 10⁻⁹).
 #[derive(Clone, Copy, Debug)]
-struct AngleScreen {
+pub(crate) struct AngleScreen {
     /// tan λ·(1 − 10⁻⁹), or 0 (nothing is below) when λ is not in (0, 1.4).
     tan_below: f64,
 }
@@ -534,7 +534,7 @@ impl AngleScreen {
     }
 
     /// `true` only if `left_angle(prev, cur, next)` is below the limit.
-    fn surely_below(&self, prev: DVec2, cur: DVec2, next: DVec2) -> bool {
+    pub(crate) fn surely_below(&self, prev: DVec2, cur: DVec2, next: DVec2) -> bool {
         let (y, x) = Self::yx(prev, cur, next);
         if !(y > 0.0 && x > 0.0) {
             return false;
@@ -921,6 +921,12 @@ impl<'a> Builder<'a> {
         let (a, b) = Self::end_angles(piece, e1, q);
         let (c, d) = Self::end_angles(piece, e2, p);
         self.angle_terms_of([a, b, c, d], tier)
+    }
+
+    /// The [`AngleScreen`] of the angle limit of tier 1 (θ₋), the tier of the repair's
+    /// searches.
+    pub(crate) fn tier1_screen(&self) -> &AngleScreen {
+        &self.screens[0]
     }
 
     /// Whether [`AngleScreen`] rejects the candidate cut from `e1` to `e2` in `tier`: a new

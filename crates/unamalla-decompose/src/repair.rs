@@ -59,7 +59,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 use unamalla_mesh::DVec2;
 
-use crate::auto::{beyond_best, needs_cut_point, triangle_plan, Builder};
+use crate::auto::{beyond_best, needs_cut_point, triangle_plan, AngleScreen, Builder};
 use crate::concavity::{concavity, concavity_with_angles, critical_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
@@ -402,11 +402,13 @@ impl Host {
     }
 }
 
-/// The new angles at the ends of the candidate cuts of one host ring — at a vertex towards
-/// the cut's other end, and at the foot of a perpendicular from a vertex towards that
-/// vertex, as [`Builder::end_angles`] computes them — each computed once for the split
+/// The new angles at the ends of the candidate cuts of one host ring in tier 1 — at a vertex
+/// towards the cut's other end, and at the foot of a perpendicular from a vertex towards
+/// that vertex, as [`Builder::end_angles`] computes them — each computed once for the split
 /// searches of the host and of its children (the second cuts of a re-split,
-/// [`Builder::best_split3`], search children of the host again and again).
+/// [`Builder::best_split3`], search children of the host again and again), or marked as
+/// rejected by the tier's [`AngleScreen`] (then every cut with that end is: the screen
+/// rejects a cut when it rejects an angle at either end).
 ///
 /// Exact: a child's vertex that has the host vertex's point and neighbours, bit for bit,
 /// has the same angles towards the same point (the same `atan2` on the same numbers); a
@@ -415,13 +417,20 @@ impl Host {
 /// same angles there. [`EndAngles::locate`] finds those vertices and edges.
 struct EndAngles<'a> {
     host: &'a [DVec2],
+    /// The screen of tier 1.
+    screen: AngleScreen,
     /// `[i·n + j]`: the two angles at host vertex `i` towards host vertex `j`, as bits;
-    /// 0 while not computed (an angle is in (0, 2π] or NaN, never +0.0).
+    /// 0 while not computed (an angle is in (0, 2π] or NaN, never +0.0), [`REJECTED`] first
+    /// if the screen rejects one of them.
     to_vertex: Vec<[AtomicU64; 2]>,
     /// `[i·n + e]`: the two angles at host vertex `i` towards the foot of its perpendicular
-    /// on host edge `e`, then the two at that foot towards vertex `i`.
+    /// on host edge `e`, then the two at that foot towards vertex `i` (or [`REJECTED`]).
     to_foot: Vec<[AtomicU64; 4]>,
 }
+
+/// The bits an [`EndAngles`] entry starts with when the screen rejects it: those of −1, never
+/// an angle.
+const REJECTED: u64 = 0xbff0_0000_0000_0000;
 
 /// Where the vertices and edges of a ring are those of an [`EndAngles`] host: host vertex
 /// of each ring vertex with the same point and neighbours, host edge of each ring edge with
@@ -432,11 +441,12 @@ struct HostMatch {
 }
 
 impl<'a> EndAngles<'a> {
-    /// An empty table of `host`'s angles.
-    fn new(host: &'a [DVec2]) -> Self {
+    /// An empty table of `host`'s angles, screened by `screen` (tier 1's).
+    fn new(host: &'a [DVec2], screen: AngleScreen) -> Self {
         let n2 = host.len() * host.len();
         Self {
             host,
+            screen,
             to_vertex: (0..n2).map(|_| Default::default()).collect(),
             to_foot: (0..n2).map(|_| Default::default()).collect(),
         }
@@ -482,47 +492,66 @@ impl<'a> EndAngles<'a> {
         HostMatch { vertex, edge }
     }
 
-    /// Reads the angles stored at `slot`, or stores and returns those `compute` gives.
+    /// Reads the angles stored at `slot`, or stores and returns those `compute` gives;
+    /// `None` if they are (or `compute` finds them) rejected by the screen.
     fn cached<const K: usize>(
         slot: &[AtomicU64; K],
-        compute: impl FnOnce() -> [f64; K],
-    ) -> [f64; K] {
+        compute: impl FnOnce() -> Option<[f64; K]>,
+    ) -> Option<[f64; K]> {
         let bits = slot.each_ref().map(|a| a.load(Ordering::Relaxed));
+        if bits[0] == REJECTED {
+            return None;
+        }
         if bits.iter().all(|&b| b != 0) {
-            return bits.map(f64::from_bits);
+            return Some(bits.map(f64::from_bits));
         }
         // another thread may compute the same angles at the same time: the same values
         let v = compute();
-        for (a, x) in slot.iter().zip(v) {
-            a.store(x.to_bits(), Ordering::Relaxed);
+        match v {
+            None => slot[0].store(REJECTED, Ordering::Relaxed),
+            Some(v) => {
+                for (a, x) in slot.iter().zip(v) {
+                    a.store(x.to_bits(), Ordering::Relaxed);
+                }
+            }
         }
         v
     }
 
-    /// The angles at host vertex `i` towards host vertex `j`.
-    fn vertex_angles(&self, i: usize, j: usize) -> [f64; 2] {
+    /// The angles at host vertex `i` towards host vertex `j`, `None` if the screen rejects
+    /// one.
+    fn vertex_angles(&self, i: usize, j: usize) -> Option<[f64; 2]> {
         let h = self.host;
         let n = h.len();
         Self::cached(&self.to_vertex[i * n + j], || {
             let (prev, p, next, q) = (h[(i + n - 1) % n], h[i], h[(i + 1) % n], h[j]);
-            [left_angle(q, p, next), left_angle(prev, p, q)]
+            let screened =
+                self.screen.surely_below(q, p, next) || self.screen.surely_below(prev, p, q);
+            (!screened).then(|| [left_angle(q, p, next), left_angle(prev, p, q)])
         })
     }
 
     /// The angles at host vertex `i` towards `x`, the foot of its perpendicular on host edge
-    /// `e`, then at `x` towards vertex `i`.
-    fn foot_angles(&self, i: usize, e: usize, x: DVec2) -> [f64; 4] {
+    /// `e`, then at `x` towards vertex `i`; `None` if the screen rejects one.
+    fn foot_angles(&self, i: usize, e: usize, x: DVec2) -> Option<[f64; 4]> {
         let h = self.host;
         let n = h.len();
         Self::cached(&self.to_foot[i * n + e], || {
             let (prev, p, next) = (h[(i + n - 1) % n], h[i], h[(i + 1) % n]);
             let (a, b) = (h[e], h[(e + 1) % n]);
-            [
-                left_angle(x, p, next),
-                left_angle(prev, p, x),
-                left_angle(p, x, b),
-                left_angle(a, x, p),
-            ]
+            let sc = &self.screen;
+            let screened = sc.surely_below(x, p, next)
+                || sc.surely_below(prev, p, x)
+                || sc.surely_below(p, x, b)
+                || sc.surely_below(a, x, p);
+            (!screened).then(|| {
+                [
+                    left_angle(x, p, next),
+                    left_angle(prev, p, x),
+                    left_angle(p, x, b),
+                    left_angle(a, x, p),
+                ]
+            })
         })
     }
 }
@@ -814,14 +843,15 @@ impl Builder<'_> {
                 ring: 0,
                 pos: Pos::Vertex(i),
             };
+            // (a cut the screen rejects at either end gets `None`, as in `angle_terms`)
             match from_table {
                 None => self.angle_terms(&piece, e1, e2, 1),
-                Some(_) if self.screened_out(&piece, e1, e2, 1) => None,
                 Some((t, hi, None, hj)) => {
-                    let ([a, b], [c, d]) = (t.vertex_angles(hi, hj), t.vertex_angles(hj, hi));
+                    let [a, b] = t.vertex_angles(hi, hj)?;
+                    let [c, d] = t.vertex_angles(hj, hi)?;
                     self.angle_terms_of([a, b, c, d], 1)
                 }
-                Some((t, hi, Some(x), he)) => self.angle_terms_of(t.foot_angles(hi, he, x), 1),
+                Some((t, hi, Some(x), he)) => self.angle_terms_of(t.foot_angles(hi, he, x)?, 1),
             }
         };
         // the target list, reused for every start vertex
@@ -1156,7 +1186,7 @@ impl Builder<'_> {
                 limit
             };
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
-            let angles = EndAngles::new(&u.pts);
+            let angles = EndAngles::new(&u.pts, *self.tier1_screen());
             let two = matches!(host, Host::Merged2 { .. })
                 .then(|| self.best_split_by(u, &good, true, Some(&angles)))
                 .flatten()
@@ -1677,7 +1707,10 @@ mod tests {
                 &pts.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>(),
                 &vec![B; n],
             );
-            let table = EndAngles::new(&host.pts);
+            let opts = DecomposeOptions::default();
+            let region = l_region();
+            let builder = Builder::new(&region, &opts);
+            let table = EndAngles::new(&host.pts, *builder.tier1_screen());
             // a child: the host from vertex i on, closed by a cut to a point inside an edge
             let i = (next() * n as f64) as usize % n;
             let len = 3 + (next() * (n - 4) as f64) as usize;
@@ -1702,10 +1735,11 @@ mod tests {
                 for l in (0..m).filter(|&l| l != k && at.vertex[l] != usize::MAX) {
                     let q = child.pts[l];
                     let (x, y) = Builder::end_angles(&piece, e1, q);
-                    assert_eq!(
-                        bits(table.vertex_angles(at.vertex[k], at.vertex[l])),
-                        bits([x, y])
-                    );
+                    // the screen rejects only angles below θ₋
+                    match table.vertex_angles(at.vertex[k], at.vertex[l]) {
+                        Some(got) => assert_eq!(bits(got), bits([x, y])),
+                        None => assert!(x.min(y) < opts.tolerances.theta_minus),
+                    }
                     checked += 1;
                 }
                 for e in (0..m).filter(|&e| at.edge[e] != usize::MAX) {
@@ -1717,8 +1751,11 @@ mod tests {
                         pos: Pos::OnEdge(e, x),
                     };
                     let (f0, f1) = Builder::end_angles(&piece, e2, child.pts[k]);
-                    let got = table.foot_angles(at.vertex[k], at.edge[e], x);
-                    assert_eq!(got.map(f64::to_bits), [p0, p1, f0, f1].map(f64::to_bits));
+                    let want = [p0, p1, f0, f1];
+                    match table.foot_angles(at.vertex[k], at.edge[e], x) {
+                        Some(got) => assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits)),
+                        None => assert!(want.iter().any(|&a| a < opts.tolerances.theta_minus)),
+                    }
                 }
             }
         }
