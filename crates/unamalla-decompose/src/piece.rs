@@ -78,6 +78,16 @@ pub(crate) struct End {
 }
 
 impl Piece {
+    /// A piece without points (a placeholder for a child that is split at once).
+    pub fn empty() -> Self {
+        Piece {
+            outer: Ring {
+                pts: Vec::new(),
+                tags: Vec::new(),
+            },
+            holes: Vec::new(),
+        }
+    }
     pub fn ring(&self, k: usize) -> &Ring {
         if k == 0 {
             &self.outer
