@@ -330,6 +330,80 @@ pub(crate) struct LayoutCache {
     node_runs: Mutex<HashMap<Vec<u64>, Arc<NodeRun>>>,
     /// The builder after applying each layout's cut list ([`AppliedCuts`]).
     applied: Mutex<Vec<Arc<AppliedCuts>>>,
+    /// The merge pass's tests of blocks and unions.
+    merges: MergeMemo,
+}
+
+/// The merge pass's tests ([`Builder::merge_pass`]), each computed once: pure functions of
+/// the points they are keyed by (and of the options, the same for every builder sharing
+/// them), so a hit returns what the computation would.
+#[derive(Default)]
+pub(crate) struct MergeMemo {
+    /// `quad_fit` of a ring, keyed by its points.
+    fits: Mutex<HashMap<Vec<u64>, f64>>,
+    /// [`MergeMemo::union_fit`], keyed by the two rings' points and cut edges.
+    unions: Mutex<HashMap<Vec<u64>, Option<f64>>>,
+}
+
+/// The bits of `pts`, appended to `key` after their count.
+fn push_points(key: &mut Vec<u64>, pts: &[DVec2]) {
+    key.push(pts.len() as u64);
+    key.extend(pts.iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits()]));
+}
+
+impl MergeMemo {
+    /// `quad_fit(pts)`.
+    fn fit(&self, pts: &[DVec2]) -> f64 {
+        let mut key = Vec::with_capacity(2 * pts.len() + 1);
+        push_points(&mut key, pts);
+        if let Some(&f) = self
+            .fits
+            .lock()
+            .ok()
+            .and_then(|m| m.get(&key).copied())
+            .as_ref()
+        {
+            return f;
+        }
+        let f = quad_fit(pts);
+        if let Ok(mut m) = self.fits.lock() {
+            m.insert(key, f);
+        }
+        f
+    }
+
+    /// The corner score (`quad_fit`) of the union of blocks `a` and `b` across their cut
+    /// edges `ea` and `eb` ([`crate::repair::union_ring`]), if the merge pass may make it: the
+    /// two share exactly two points, and the union is approximately convex without a
+    /// critical angle; `None` otherwise.
+    fn union_fit(&self, tol: &Tolerances, a: &Ring, ea: usize, b: &Ring, eb: usize) -> Option<f64> {
+        let mut key = Vec::with_capacity(2 * (a.len() + b.len()) + 4);
+        push_points(&mut key, &a.pts);
+        key.push(ea as u64);
+        push_points(&mut key, &b.pts);
+        key.push(eb as u64);
+        if let Some(f) = self.unions.lock().ok().and_then(|m| m.get(&key).copied()) {
+            return f;
+        }
+        let f = (|| {
+            let shared = a.pts.iter().filter(|p| b.pts.contains(p)).count();
+            if shared != 2 {
+                return None;
+            }
+            let u = crate::repair::union_ring(a, ea, b, eb)?;
+            let conc = concavity(&u.pts);
+            if !conc.approximately_convex(tol)
+                || !crate::concavity::critical_angles(&u.pts, tol.theta_minus).is_empty()
+            {
+                return None;
+            }
+            Some(quad_fit(&u.pts))
+        })();
+        if let Ok(mut m) = self.unions.lock() {
+            m.insert(key, f);
+        }
+        f
+    }
 }
 
 /// A [`Builder`] (of the cache's region and options) right after [`Builder::apply_cut`] of
@@ -1684,12 +1758,16 @@ impl<'a> Builder<'a> {
     /// cuts are dropped and the remaining cuts renumbered; leaf nodes of the tree point to the
     /// merged block.
     fn merge_pass(&mut self, rings: Vec<Ring>) -> Vec<Ring> {
-        let tol = self.opts.tolerances;
+        // the tests of blocks and unions, shared with the other layouts of the region (or
+        // kept for this pass's rounds)
+        let cache = self.cache.clone();
+        let local = MergeMemo::default();
+        let memo = cache.as_deref().map_or(&local, |c| &c.merges);
         let mut slot: Vec<Option<Ring>> = rings.into_iter().map(Some).collect();
         let mut owner: Vec<usize> = (0..slot.len()).collect(); // union-find over slots
         let mut fit: Vec<f64> = slot
             .iter()
-            .map(|r| r.as_ref().map_or(0.0, |r| quad_fit(&r.pts)))
+            .map(|r| r.as_ref().map_or(0.0, |r| memo.fit(&r.pts)))
             .collect();
         let mut alive_cut = vec![true; self.cuts.len()];
         loop {
@@ -1713,47 +1791,20 @@ impl<'a> Builder<'a> {
                 let (Some(a), Some(b)) = (&slot[ka], &slot[kb]) else {
                     continue;
                 };
-                // exactly one shared cut and no other shared point
-                let shared = a.pts.iter().filter(|p| b.pts.contains(p)).count();
-                if shared != 2 {
+                // exactly one shared cut and no other shared point; the union approximately
+                // convex and without a critical angle
+                let Some(f) = memo.union_fit(&self.opts.tolerances, a, ea, b, eb) else {
                     continue;
-                }
-                let na = a.len();
-                let nb = b.len();
-                // A: edge ea runs u → v; union = A from v around to u, then B after u to before v
-                let mut pts = Vec::with_capacity(na + nb - 2);
-                let mut tags = Vec::with_capacity(na + nb - 2);
-                for s in 1..=na {
-                    let k = (ea + s) % na;
-                    pts.push(a.pts[k]);
-                    tags.push(if s == na {
-                        b.tags[(eb + 1) % nb]
-                    } else {
-                        a.tags[k]
-                    });
-                }
-                for s in 2..nb {
-                    let k = (eb + s) % nb;
-                    pts.push(b.pts[k]);
-                    tags.push(b.tags[k]);
-                }
-                if pts.len() < 3 || tags.len() != pts.len() {
-                    continue;
-                }
-                let conc = concavity(&pts);
-                if !conc.approximately_convex(&tol)
-                    || !crate::concavity::critical_angles(&pts, tol.theta_minus).is_empty()
-                {
-                    continue;
-                }
-                let f = quad_fit(&pts);
+                };
                 let worst = fit[ka].max(fit[kb]);
                 // a triangle bounded by cuts only could get its fourth corner only inside a cut
                 // (a valence-3 interior node): merge it whenever the union is admissible
                 let cut_triangle =
                     |r: &Ring| r.len() == 3 && r.tags.iter().all(|t| matches!(t, Tag::Cut(_)));
                 if f <= worst + 0.02 || cut_triangle(a) || cut_triangle(b) {
-                    cands.push((worst - f, c, Ring { pts, tags }));
+                    if let Some(u) = crate::repair::union_ring(a, ea, b, eb) {
+                        cands.push((worst - f, c, u));
+                    }
                 }
             }
             if cands.is_empty() {
@@ -1770,7 +1821,7 @@ impl<'a> Builder<'a> {
                 }
                 touched[ka] = true;
                 touched[kb] = true;
-                fit[ka] = quad_fit(&ring.pts);
+                fit[ka] = memo.fit(&ring.pts);
                 slot[ka] = Some(ring);
                 slot[kb] = None;
                 owner[kb] = ka;
