@@ -18,7 +18,7 @@ use crate::error::DecomposeError;
 use crate::geom::{
     angle_penalty, child_hull, child_hull_order, convex_hull, hull_from_order, hull_order,
     left_angle, match_vertices, perimeter, project_t, ray_segment, ring_angle, ring_angles,
-    ring_angles_matched, visit_sorted,
+    ring_angles_matched, visit_sorted, HullKey,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -435,6 +435,34 @@ fn piece_key(piece: &Piece) -> Vec<u64> {
         r.push_key(&mut key, |c, key| key.extend([1, c as u64]));
     }
     key
+}
+
+/// What Algorithm 1 computes of a ring before cutting it: the vertex angles, the points in
+/// hull order, the convex hull (and whether the points are pairwise different) and the
+/// concavity measures — those of [`concavity`], computed the same way.
+struct Shape {
+    angle: Vec<f64>,
+    hull_keys: Vec<HullKey>,
+    hull: Vec<usize>,
+    distinct: bool,
+    conc: crate::concavity::Concavity,
+}
+
+impl Shape {
+    /// The shape of the ring `pts`.
+    fn of(pts: &[DVec2]) -> Self {
+        let angle = ring_angles(pts);
+        let hull_keys = hull_order(pts);
+        let (hull, distinct) = hull_from_order(pts, &hull_keys);
+        let conc = concavity_with_hull(pts, &angle, hull.clone());
+        Self {
+            angle,
+            hull_keys,
+            hull,
+            distinct,
+            conc,
+        }
+    }
 }
 
 /// The content of a piece up to its cut ids, and those ids: the points, per edge the region
@@ -1038,11 +1066,11 @@ impl<'a> Builder<'a> {
             let (a, b, c1, c2) = self.remove_hole(&piece)?;
             Some((Step::HoleRemoval, vec![c1, c2], a, b, true))
         } else {
-            let conc = concavity(&piece.outer.pts);
+            let shape = Shape::of(&piece.outer.pts);
             let mut r = None;
-            if !conc.approximately_convex(tol) {
+            if !shape.conc.approximately_convex(tol) {
                 r = self
-                    .concavity_cut(&piece)
+                    .concavity_cut(&piece, &shape)
                     .map(|(a, b, c)| (Step::Concavity, vec![c], a, b, true));
             }
             if r.is_none() && self.opts.critical_triangles && piece.outer.len() > 3 {
@@ -1469,13 +1497,18 @@ impl<'a> Builder<'a> {
     }
 
     /// Algorithm 3: one concavity cut from a deep reflex vertex p to the best q.
-    fn concavity_cut(&mut self, piece: &Piece) -> Option<(Piece, Piece, usize)> {
+    /// `shape` is the [`Shape`] of the piece's outer ring.
+    fn concavity_cut(&mut self, piece: &Piece, shape: &Shape) -> Option<(Piece, Piece, usize)> {
         let ring = &piece.outer;
         let n = ring.len();
-        let angle: Vec<f64> = ring_angles(&ring.pts);
-        let hull_keys = hull_order(&ring.pts);
-        let (hull, distinct) = hull_from_order(&ring.pts, &hull_keys);
-        let conc = concavity_with_hull(&ring.pts, &angle, hull.clone());
+        let Shape {
+            angle,
+            hull_keys,
+            hull,
+            distinct,
+            conc,
+        } = shape;
+        let (hull_keys, hull, distinct) = (hull_keys.as_slice(), hull.as_slice(), *distinct);
         let area = piece.area();
         let sq = area.sqrt();
         let mut starts: Vec<usize> = (0..n)
