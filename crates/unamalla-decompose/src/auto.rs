@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use unamalla_mesh::{DVec2, Region};
 
-use crate::concavity::{concavity, concavity_with_hull, Tolerances};
+use crate::concavity::{concavity_with_hull, measures, measures_with_hull, Tolerances};
 use crate::corners::{
     quad_fit, quad_fit_with_angles, select_corners, triangle_rule, CornerWeights, TriangleBlock,
 };
@@ -391,7 +391,7 @@ impl MergeMemo {
                 return None;
             }
             let u = crate::repair::union_ring(a, ea, b, eb)?;
-            let conc = concavity(&u.pts);
+            let conc = measures(&u.pts);
             if !conc.approximately_convex(tol)
                 || !crate::concavity::critical_angles(&u.pts, tol.theta_minus).is_empty()
             {
@@ -1488,7 +1488,7 @@ impl<'a> Builder<'a> {
     /// [`concavity_with_hull`] takes it) are given, for the concavity measures and the corner
     /// score.
     fn badness_with_hull(&self, ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> f64 {
-        let c = concavity_with_hull(ring, angles, hull);
+        let c = measures_with_hull(ring, angles, hull);
         if c.approximately_convex(&self.opts.tolerances) {
             quad_fit_with_angles(ring, angles)
         } else {

@@ -60,7 +60,7 @@ use rayon::prelude::*;
 use unamalla_mesh::DVec2;
 
 use crate::auto::{beyond_best, needs_cut_point, triangle_plan, AngleScreen, Builder};
-use crate::concavity::{concavity, concavity_with_angles, critical_angles};
+use crate::concavity::{critical_angles, measures, measures_with_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
@@ -667,7 +667,7 @@ impl Builder<'_> {
         !angles.iter().any(|&a| a < tol.theta_minus)
             && (ring.len() < 3 || angles.iter().copied().fold(0.0, f64::max) <= tol.theta_plus)
             && self.usable_with_angles(&ring.pts, angles)
-            && concavity_with_angles(&ring.pts, angles).approximately_convex(tol)
+            && measures_with_angles(&ring.pts, angles).approximately_convex(tol)
     }
 
     /// The corner score F of a good block ([`Builder::good`]); `None` if it is not good. The
@@ -701,7 +701,7 @@ impl Builder<'_> {
         } else {
             !crit.is_empty()
                 || !self.usable(&ring.pts)
-                || !concavity(&ring.pts).approximately_convex(tol)
+                || !measures(&ring.pts).approximately_convex(tol)
         }
     }
 
@@ -1287,7 +1287,7 @@ impl Builder<'_> {
         if triangle.is_none() && !self.usable(&ring.pts) {
             return None;
         }
-        let grade = if concavity(&ring.pts).approximately_convex(tol) {
+        let grade = if measures(&ring.pts).approximately_convex(tol) {
             1.0
         } else {
             3.0
