@@ -1214,18 +1214,16 @@ impl Builder<'_> {
             fold(&mut best, *host, f);
         }
         // the fewest blocks disturbed: two neighbours only when no re-split of the block
-        // alone or with one neighbour works, and only up to the first of those that works
-        // (searched a few at a time in parallel: a later one would be searched in vain)
-        for chunk in hosts2.chunks(rayon::current_num_threads().max(1)) {
-            if best.is_some() {
-                break;
-            }
-            let found: Vec<Vec<Resplit>> = chunk.par_iter().map(candidates).collect();
-            for ((host, _), f) in chunk.iter().zip(found) {
-                if best.is_some() {
-                    break;
-                }
-                fold(&mut best, *host, f);
+        // alone or with one neighbour works, and then the first of those that works (the
+        // sequential loop stops at the next one once it has a candidate; searched in
+        // parallel, the later ones are given up once an earlier one has candidates)
+        if best.is_none() {
+            let first = hosts2
+                .par_iter()
+                .map(|h| (h.0, candidates(h)))
+                .find_first(|(_, found)| !found.is_empty());
+            if let Some((host, found)) = first {
+                fold(&mut best, host, found);
             }
         }
         best
