@@ -717,6 +717,17 @@ impl AngleScreen {
     }
 }
 
+/// What trying a candidate cut of the concavity cut found: not admissible or a child too
+/// small (`Skipped`), or its score.
+enum Trial {
+    Skipped,
+    Score(f64),
+}
+
+/// Pieces at least this long try a few candidate cuts at a time in parallel (shorter ones
+/// run in parallel with the other leaves).
+const PARALLEL_TRIALS_MIN_LEN: usize = 64;
+
 /// Whether a candidate cut whose cheap terms are `pre` (and every later one: the candidates
 /// are sorted by `pre`) cannot beat the best score `best` so far.
 ///
@@ -1585,19 +1596,14 @@ impl<'a> Builder<'a> {
                     })
                     .then(ka.cmp(&kb))
             };
-            let mut best: Option<(f64, Cand)> = None;
-            let mut evaluated = 0;
-            visit_sorted(&mut order, cmp, |&k| {
-                let c = &cands[k];
-                if evaluated >= 60 {
-                    return false;
-                }
-                // no later candidate can win (exact, see `beyond_best`)
-                if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
-                    return false;
-                }
+            // the trial of a candidate (pure: admissible, both children large enough, their
+            // score); for a large piece a few are tried at a time in parallel and their trials
+            // taken in order as the sequential loop would (one tried beyond where it stops
+            // is work lost, not a different result)
+            let this = &*self;
+            let trial = |c: &Cand| -> Trial {
                 if !piece.admissible(&idx, c.e1, c.e2) {
-                    return true;
+                    return Trial::Skipped;
                 }
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);
@@ -1605,14 +1611,13 @@ impl<'a> Builder<'a> {
                 let (aa, ab) = (a.area(), b.area());
                 // the last tier also accepts pieces down to a tenth of the negligible area
                 let min_area = if tier == 3 {
-                    0.1 * self.min_area
+                    0.1 * this.min_area
                 } else {
-                    self.min_area
+                    this.min_area
                 };
                 if aa < min_area || ab < min_area {
-                    return true;
+                    return Trial::Skipped;
                 }
-                evaluated += 1;
                 // the children's vertex angles from the piece's where a vertex keeps its
                 // neighbours (exact, `ring_angles_matched`): `a` starts at the cut's first end
                 // (vertex `i` of the piece), `b` at its second end (a vertex, or a point inside
@@ -1630,28 +1635,71 @@ impl<'a> Builder<'a> {
                 // large child (`child_hull_order`; both exact, for pairwise different points)
                 let badness = |child: &[DVec2], start: usize| {
                     let map = match_vertices(child, &ring.pts, start);
-                    let angles = ring_angles_matched(child, &ring.pts, &angle, &map);
+                    let angles = ring_angles_matched(child, &ring.pts, angle, &map);
                     let large = 8 * child.len() >= n;
                     let hull = distinct
-                        .then(|| child_hull(&ring.pts, &hull, child, &map))
+                        .then(|| child_hull(&ring.pts, hull, child, &map))
                         .flatten()
                         .or_else(|| {
                             let keys = (distinct && large)
-                                .then(|| child_hull_order(&hull_keys, n, child, &map))
+                                .then(|| child_hull_order(hull_keys, n, child, &map))
                                 .flatten()?;
                             Some(hull_from_order(child, &keys).0)
                         })
                         .unwrap_or_else(|| convex_hull(child));
-                    self.badness_with_hull(child, &angles, hull)
+                    this.badness_with_hull(child, &angles, hull)
                 };
                 let ba = badness(&a.outer.pts, start_a);
                 let bb = badness(&b.outer.pts, start_b);
-                let s = 0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre;
-                if best.as_ref().is_none_or(|b| s < b.0) {
-                    best = Some((s, *c));
+                Trial::Score(0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre)
+            };
+            let chunk = if n >= PARALLEL_TRIALS_MIN_LEN {
+                rayon::current_num_threads().max(1)
+            } else {
+                1
+            };
+            let mut best: Option<(f64, Cand)> = None;
+            let mut evaluated = 0;
+            // takes the trials of `ks` in order; `false` where the sequential loop stops
+            let mut take = |ks: &[usize]| -> bool {
+                let trials: Vec<Trial> = if ks.len() > 1 {
+                    ks.par_iter().map(|&k| trial(&cands[k])).collect()
+                } else {
+                    ks.iter().map(|&k| trial(&cands[k])).collect()
+                };
+                for (&k, t) in ks.iter().zip(trials) {
+                    let c = &cands[k];
+                    if evaluated >= 60 {
+                        return false;
+                    }
+                    // no later candidate can win (exact, see `beyond_best`)
+                    if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
+                        return false;
+                    }
+                    let Trial::Score(s) = t else {
+                        continue;
+                    };
+                    evaluated += 1;
+                    if best.as_ref().is_none_or(|b| s < b.0) {
+                        best = Some((s, *c));
+                    }
                 }
                 true
+            };
+            let mut pending: Vec<usize> = Vec::with_capacity(chunk);
+            let mut going = true;
+            visit_sorted(&mut order, cmp, |&k| {
+                pending.push(k);
+                if pending.len() < chunk {
+                    return true;
+                }
+                going = take(&pending);
+                pending.clear();
+                going
             });
+            if going && !pending.is_empty() {
+                take(&pending);
+            }
             if let Some((_, c)) = best {
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);
