@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use unamalla_mesh::geometry::{open_segment_hits, point_segment_distance};
 use unamalla_mesh::{DVec2, Region, SegmentIndex};
@@ -430,8 +431,9 @@ pub(crate) fn classify(
         }
     }
     check_cuts(region, cuts)?;
-    // blocks: simple, counter-clockwise
-    for b in blocks {
+    // blocks: simple, counter-clockwise (checked in parallel; the first failing block in
+    // order gives the error, as a sequential loop would)
+    let block_ok = |b: &Block| -> Result<(), DecomposeError> {
         if b.ring.len() < 3 {
             return Err(DecomposeError::BlockTooSmall {
                 block: b.id,
@@ -452,7 +454,9 @@ pub(crate) fn classify(
                 edge_b: y.edge,
             });
         }
-    }
+        Ok(())
+    };
+    first_error(blocks.par_iter().map(block_ok).collect())?;
     // edges: cut or boundary
     let key = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
     let mut cut_map: HashMap<(PointKey, PointKey), usize> = HashMap::new();
@@ -462,18 +466,23 @@ pub(crate) fn classify(
     }
     let rings: Vec<&[DVec2]> = region.rings().map(|p| p.points()).collect();
     let index = region.edge_index();
-    let mut uses: Vec<Vec<(usize, DVec2)>> = vec![Vec::new(); cuts.len()];
-    // per region edge: (t of start, start, end)
-    let mut cover: HashMap<(usize, usize), CoverList> = HashMap::new();
-    let mut kinds: Vec<Vec<Option<(bool, usize)>>> = Vec::with_capacity(blocks.len());
-    for b in blocks {
+    // each block's edges, in parallel: the kinds, the cuts used (cut, start point) and the
+    // region edges covered ((ring, edge), (t of start, start, end)); gathered in block
+    // order below, as a sequential loop would record them
+    type BlockEdges = (
+        Vec<Option<(bool, usize)>>,
+        Vec<(usize, DVec2)>,
+        Vec<((usize, usize), (f64, DVec2, DVec2))>,
+    );
+    let block_edges = |b: &Block| -> Result<BlockEdges, DecomposeError> {
         let n = b.ring.len();
         let mut ks = Vec::with_capacity(n);
+        let (mut used, mut covered) = (Vec::new(), Vec::new());
         for e in 0..n {
             let u = b.ring[e];
             let v = b.ring[(e + 1) % n];
             if let Some(&c) = cut_map.get(&(key(u), key(v))) {
-                uses[c].push((b.id, u));
+                used.push((c, u));
                 ks.push(Some((true, c)));
                 continue;
             }
@@ -504,8 +513,24 @@ pub(crate) fn classify(
             };
             let (a, bb) = index.edge(er);
             let t = crate::geom::project_t(u, a, bb);
-            cover.entry((er.ring, er.edge)).or_default().push((t, u, v));
+            covered.push(((er.ring, er.edge), (t, u, v)));
             ks.push(Some((false, er.ring)));
+        }
+        Ok((ks, used, covered))
+    };
+    let per_block: Vec<Result<BlockEdges, DecomposeError>> =
+        blocks.par_iter().map(block_edges).collect();
+    let mut uses: Vec<Vec<(usize, DVec2)>> = vec![Vec::new(); cuts.len()];
+    // per region edge: (t of start, start, end)
+    let mut cover: HashMap<(usize, usize), CoverList> = HashMap::new();
+    let mut kinds: Vec<Vec<Option<(bool, usize)>>> = Vec::with_capacity(blocks.len());
+    for (b, r) in blocks.iter().zip(per_block) {
+        let (ks, used, covered) = r?;
+        for (c, u) in used {
+            uses[c].push((b.id, u));
+        }
+        for (edge, entry) in covered {
+            cover.entry(edge).or_default().push(entry);
         }
         kinds.push(ks);
     }
@@ -585,12 +610,19 @@ pub(crate) fn classify(
     ))
 }
 
+/// The first error of `results` (in order), as a loop stopping there would return it.
+fn first_error(results: Vec<Result<(), DecomposeError>>) -> Result<(), DecomposeError> {
+    results.into_iter().collect()
+}
+
 /// Cuts: finite, endpoints on the boundary (or at a joint shared with another cut, where the
 /// triangle-block rule split a cut), inside the region, pairwise disjoint.
 pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeError> {
     let tol = boundary_tol(region);
     let index = region.edge_index();
-    for c in cuts {
+    // each cut on its own, in parallel; the first failing cut in order gives the error, as a
+    // sequential loop would
+    let cut_ok = |c: &Cut| -> Result<(), DecomposeError> {
         for (name, p) in [('a', c.a), ('b', c.b)] {
             if !p.is_finite() {
                 return Err(DecomposeError::NonFinite {
@@ -642,10 +674,12 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
         {
             return Err(err);
         }
-    }
+        Ok(())
+    };
+    first_error(cuts.par_iter().map(cut_ok).collect())?;
     if cuts.len() > 1 {
         let cut_index = SegmentIndex::new(cuts.iter().map(|c| vec![c.a, c.b]).collect());
-        for c in cuts {
+        let disjoint = |c: &Cut| -> Result<(), DecomposeError> {
             for er in cut_index.candidates(c.a, c.b) {
                 if er.ring == c.id {
                     continue;
@@ -658,7 +692,9 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
                     });
                 }
             }
-        }
+            Ok(())
+        };
+        first_error(cuts.par_iter().map(disjoint).collect())?;
     }
     Ok(())
 }
