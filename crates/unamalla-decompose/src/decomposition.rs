@@ -620,6 +620,7 @@ fn first_error(results: Vec<Result<(), DecomposeError>>) -> Result<(), Decompose
 pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeError> {
     let tol = boundary_tol(region);
     let index = region.edge_index();
+    let max_x = region.bounding_box().1.x;
     // each cut on its own, in parallel; the first failing cut in order gives the error, as a
     // sequential loop would
     let cut_ok = |c: &Cut| -> Result<(), DecomposeError> {
@@ -668,8 +669,8 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
             .min(0.25);
         let a2 = c.a + shrink * d;
         let b2 = c.b - shrink * d;
-        if !(contains_point_with(region, &index, a2)
-            && contains_point_with(region, &index, b2)
+        if !(contains_point_with(region, &index, max_x, a2)
+            && contains_point_with(region, &index, max_x, b2)
             && !index.open_segment_blocked(a2, b2))
         {
             return Err(err);
@@ -700,8 +701,9 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
 }
 
 /// [`Region::contains_point`] (`p` in the open region) with `index` =
-/// [`Region::edge_index`] of `region`, looking only at the edges whose bounding box meets the
-/// horizontal ray from `p` to the right.
+/// [`Region::edge_index`] of `region` and `max_x` the largest `x` of its bounding box,
+/// looking only at the edges whose bounding box meets the horizontal ray from `p` to the
+/// right (up to `max_x`).
 ///
 /// The same answer: `contains_point` locates `p` in each ring by the winding number of
 /// `locate_in_ring` (an edge counts +1 if it goes up across the height of `p` with `p`
@@ -712,10 +714,14 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
 /// The rules are evaluated here on the same numbers with the same predicates. `p` is inside
 /// exactly when it is on no edge, the outer ring's winding number is not 0 and every hole's
 /// is (a point inside a hole or on any ring is not in the open region).
-pub(crate) fn contains_point_with(region: &Region, index: &SegmentIndex, p: DVec2) -> bool {
-    let (_, hi) = region.bounding_box();
+pub(crate) fn contains_point_with(
+    region: &Region,
+    index: &SegmentIndex,
+    max_x: f64,
+    p: DVec2,
+) -> bool {
     let mut winding = vec![0i64; region.rings().count()];
-    for er in index.candidates(p, DVec2::new(hi.x, p.y)) {
+    for er in index.candidates(p, DVec2::new(max_x, p.y)) {
         let (a, b) = index.edge(er);
         let o = unamalla_mesh::geometry::orient2d(a, b, p);
         if o == 0.0 && unamalla_mesh::geometry::point_on_segment(a, b, p) {
@@ -814,7 +820,7 @@ mod tests {
         }
         for p in points {
             assert_eq!(
-                contains_point_with(&region, &index, p),
+                contains_point_with(&region, &index, region.bounding_box().1.x, p),
                 region.contains_point(p),
                 "{p:?}"
             );

@@ -346,18 +346,17 @@ type FitEntry = (Box<[DVec2]>, Option<f64>);
 impl FitMemo {
     /// `b.good_fit(ring)`, computed once per vertex sequence.
     fn good_fit(&self, b: &Builder<'_>, ring: &Ring) -> Option<f64> {
-        use std::hash::{Hash, Hasher};
         let same = |p: &[DVec2]| {
             p.len() == ring.pts.len()
                 && p.iter()
                     .zip(&ring.pts)
                     .all(|(a, b)| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits())
         };
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        for p in &ring.pts {
-            (p.x.to_bits(), p.y.to_bits()).hash(&mut h);
-        }
-        let h = h.finish();
+        // the bucket: a quick hash of the coordinates' bits (FxHash's multiply and rotate;
+        // the entries in a bucket are told apart by the full sequence)
+        const K: u64 = 0x517c_c1b7_2722_0a95;
+        let mix = |h: u64, x: f64| (h.rotate_left(5) ^ x.to_bits()).wrapping_mul(K);
+        let h = ring.pts.iter().fold(0u64, |h, p| mix(mix(h, p.x), p.y));
         if let Ok(m) = self.0.lock() {
             if let Some(f) = m.get(&h).and_then(|v| v.iter().find(|e| same(&e.0))) {
                 return f.1;
