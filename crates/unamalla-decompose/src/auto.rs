@@ -1605,9 +1605,7 @@ impl<'a> Builder<'a> {
                 if !piece.admissible(&idx, c.e1, c.e2) {
                     return Trial::Skipped;
                 }
-                let mut m = piece.clone();
-                let (x, y) = m.insert_ends(c.e1, c.e2);
-                let (a, b) = m.split(x, y, usize::MAX);
+                let (a, b, _) = piece.split_between(c.e1, c.e2, usize::MAX);
                 let (aa, ab) = (a.area(), b.area());
                 // the last tier also accepts pieces down to a tenth of the negligible area
                 let min_area = if tier == 3 {

@@ -206,6 +206,54 @@ impl Piece {
         }
     }
 
+    /// The two pieces and the end points of the cut `cut` from `e1` to `e2` (on the outer
+    /// ring): what `insert_ends(e1, e2)` then `split` on a copy of the piece give, built from
+    /// one pass over the ring with the inserted points in place (each right after the vertex
+    /// that starts its edge, as `insert` puts it) instead of the copy and two insertions.
+    /// Both ends inside one edge take the general path.
+    pub fn split_between(&self, e1: End, e2: End, cut: usize) -> (Piece, Piece, (DVec2, DVec2)) {
+        let on_edge = |e: End| match e.pos {
+            Pos::OnEdge(i, x) => Some((i, x)),
+            Pos::Vertex(_) => None,
+        };
+        let (o1, o2) = (on_edge(e1), on_edge(e2));
+        let one_edge = matches!((o1, o2), (Some((i, _)), Some((j, _))) if i == j);
+        if e1.ring != 0 || e2.ring != 0 || one_edge {
+            let mut m = self.clone();
+            let (x, y) = m.insert_ends(e1, e2);
+            let (a, b) = m.split(x, y, cut);
+            return (a, b, (m.outer.p(x), m.outer.p(y)));
+        }
+        let r = &self.outer;
+        let n = r.len();
+        let mut pts = Vec::with_capacity(n + 2);
+        let mut tags = Vec::with_capacity(n + 2);
+        let (mut x, mut y) = (0, 0);
+        for k in 0..n {
+            if e1.pos == Pos::Vertex(k) {
+                x = pts.len();
+            }
+            if e2.pos == Pos::Vertex(k) {
+                y = pts.len();
+            }
+            pts.push(r.pts[k]);
+            tags.push(r.tags[k]);
+            for (o, at) in [(o1, &mut x), (o2, &mut y)] {
+                if let Some((i, p)) = o.filter(|&(i, _)| i == k) {
+                    *at = pts.len();
+                    pts.push(p);
+                    tags.push(r.tags[i]);
+                }
+            }
+        }
+        let m = Piece {
+            outer: Ring { pts, tags },
+            holes: self.holes.clone(),
+        };
+        let (a, b) = m.split(x, y, cut);
+        (a, b, (m.outer.p(x), m.outer.p(y)))
+    }
+
     /// Splits the outer ring at vertices `i` and `j` by cut `cut`; holes go to the child that
     /// contains them. Returns `(A, B)` with A = `i … j` + cut, B = `j … i` + cut.
     pub fn split(&self, i: usize, j: usize, cut: usize) -> (Piece, Piece) {
@@ -301,6 +349,55 @@ mod tests {
                 tags: vec![Tag::Boundary(1); 4],
                 pts: hole,
             }],
+        }
+    }
+
+    /// `split_between` gives what a copy with `insert_ends` and `split` gives, for every pair
+    /// of ends (vertices, points inside edges) of a hexagon.
+    #[test]
+    fn split_between_matches_insert_then_split() {
+        let pts = vec![
+            v(0., 0.),
+            v(2., -1.),
+            v(4., 0.),
+            v(4., 3.),
+            v(2., 4.),
+            v(0., 3.),
+        ];
+        let n = pts.len();
+        let piece = Piece {
+            outer: Ring {
+                tags: (0..n)
+                    .map(|i| {
+                        if i % 2 == 0 {
+                            Tag::Boundary(0)
+                        } else {
+                            Tag::Cut(i)
+                        }
+                    })
+                    .collect(),
+                pts: pts.clone(),
+            },
+            holes: Vec::new(),
+        };
+        let ends: Vec<End> = (0..n)
+            .flat_map(|i| {
+                let (a, b) = (pts[i], pts[(i + 1) % n]);
+                [Pos::Vertex(i), Pos::OnEdge(i, a + 0.3 * (b - a))]
+            })
+            .map(|pos| End { ring: 0, pos })
+            .collect();
+        for &e1 in &ends {
+            for &e2 in &ends {
+                if e1 == e2 {
+                    continue;
+                }
+                let mut m = piece.clone();
+                let (x, y) = m.insert_ends(e1, e2);
+                let (a, b) = m.split(x, y, 99);
+                let want = (a, b, (m.outer.p(x), m.outer.p(y)));
+                assert_eq!(piece.split_between(e1, e2, 99), want, "{e1:?} {e2:?}");
+            }
         }
     }
 

@@ -926,10 +926,8 @@ impl Builder<'_> {
             {
                 return true;
             }
-            let mut m = piece.clone();
-            let (x, y) = m.insert_ends(e1, e2);
-            let (a, b) = m.split(x, y, TMP_CUT);
-            visit(pre, a.outer, b.outer, (m.outer.p(x), m.outer.p(y)));
+            let (a, b, ends) = piece.split_between(e1, e2, TMP_CUT);
+            visit(pre, a.outer, b.outer, ends);
             true
         });
     }
