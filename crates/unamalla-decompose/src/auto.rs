@@ -1628,9 +1628,10 @@ impl<'a> Builder<'a> {
                     Pos::Vertex(i) => i,
                     Pos::OnEdge(e, _) => e + 1,
                 };
-                // and their convex hulls from the piece's: the piece's hull where the child
-                // keeps its vertices (`child_hull`), else from the piece's sorted points for a
-                // large child (`child_hull_order`; both exact, for pairwise different points)
+                // and their convex hulls from the piece's: from the piece's hull vertices
+                // the child keeps and its points beyond them (`child_hull`), else from the
+                // piece's sorted points for a large child (`child_hull_order`; both exact,
+                // for pairwise different points)
                 let badness = |child: &[DVec2], start: usize| {
                     let map = match_vertices(child, &ring.pts, start);
                     let angles = ring_angles_matched(child, &ring.pts, angle, &map);
