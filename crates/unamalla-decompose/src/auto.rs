@@ -863,8 +863,8 @@ impl<'a> Builder<'a> {
             let (Some(e1), Some(e2)) = (locate(a), locate(b)) else {
                 continue;
             };
-            let idx = piece.index();
-            if !piece.admissible(&idx, e1, e2) {
+            // one test on this piece: a scan of its edges (`admissible_scan`)
+            if !piece.admissible_scan(e1, e2) {
                 continue;
             }
             if e1.ring != 0 && e2.ring != 0 {

@@ -130,6 +130,39 @@ impl Piece {
     /// the segment leaves each endpoint into the region-side wedge and its open part meets no
     /// edge. Endpoints inside edges are checked against the two half-edges they create.
     pub fn admissible(&self, idx: &SegmentIndex, e1: End, e2: End) -> bool {
+        self.admissible_near(e1, e2, &|p, q, test| {
+            idx.candidates(p, q)
+                .all(|er| test((er.ring, er.edge), idx.edge(er)))
+        })
+    }
+
+    /// [`Piece::admissible`] without an index, for a single test: the piece's edges are
+    /// scanned, those whose bounding box misses the segment's skipped (the index's
+    /// candidates are those whose box meets it; the others cannot meet the segment), so the
+    /// same edges decide.
+    pub fn admissible_scan(&self, e1: End, e2: End) -> bool {
+        self.admissible_near(e1, e2, &|p, q, test| {
+            let (lo, hi) = (p.min(q), p.max(q));
+            self.rings().enumerate().all(|(r, ring)| {
+                (0..ring.len()).all(|i| {
+                    let (a, b) = (ring.p(i), ring.next(i));
+                    let apart = a.max(b).cmplt(lo).any() || a.min(b).cmpgt(hi).any();
+                    apart || test((r, i), (a, b))
+                })
+            })
+        })
+    }
+
+    /// [`Piece::admissible`] with the edges that may meet the open segment `pq`: `near(p, q,
+    /// test)` calls `test((ring, edge), (start, end))` on each of them (at least) while it
+    /// returns `true`, and says whether all passed.
+    #[allow(clippy::type_complexity)]
+    fn admissible_near(
+        &self,
+        e1: End,
+        e2: End,
+        near: &dyn Fn(DVec2, DVec2, &mut dyn FnMut((usize, usize), (DVec2, DVec2)) -> bool) -> bool,
+    ) -> bool {
         let p = self.point(e1);
         let q = self.point(e2);
         if p == q {
@@ -149,15 +182,11 @@ impl Piece {
         if h1.is_some() && h1 == h2 {
             return false;
         }
-        for er in idx.candidates(p, q) {
-            let key = Some((er.ring, er.edge));
-            if key == h1 || key == h2 {
-                continue;
-            }
-            let (a, b) = idx.edge(er);
-            if open_segment_hits(p, q, a, b) {
-                return false;
-            }
+        let clear = near(p, q, &mut |key, (a, b)| {
+            Some(key) == h1 || Some(key) == h2 || !open_segment_hits(p, q, a, b)
+        });
+        if !clear {
+            return false;
         }
         for (e, h) in [(e1, h1), (e2, h2)] {
             if let Some((r, i)) = h {
@@ -399,6 +428,34 @@ mod tests {
                 assert_eq!(piece.split_between(e1, e2, 99), want, "{e1:?} {e2:?}");
             }
         }
+    }
+
+    /// `admissible_scan` answers as `admissible` with an index, for every pair of ends
+    /// (vertices, points inside edges) of a square with a square hole.
+    #[test]
+    fn scanned_admissibility_matches_the_indexed_one() {
+        let p = square_with_hole();
+        let idx = p.index();
+        let ends: Vec<End> = p
+            .rings()
+            .enumerate()
+            .flat_map(|(r, ring)| {
+                (0..ring.len()).flat_map(move |i| {
+                    let (a, b) = (ring.p(i), ring.next(i));
+                    [Pos::Vertex(i), Pos::OnEdge(i, a + 0.5 * (b - a))]
+                        .map(|pos| End { ring: r, pos })
+                })
+            })
+            .collect();
+        let mut admitted = 0;
+        for &e1 in &ends {
+            for &e2 in &ends {
+                let want = p.admissible(&idx, e1, e2);
+                assert_eq!(p.admissible_scan(e1, e2), want, "{e1:?} {e2:?}");
+                admitted += want as usize;
+            }
+        }
+        assert!(admitted > 10, "{admitted}");
     }
 
     #[test]
