@@ -30,7 +30,7 @@
 //! Chords ending within `max(s, w/2)` of an earlier cut end are skipped (no fans), as are
 //! chords making an angle below [`MIN_END_ANGLE_DEG`] with the boundary.
 
-use std::collections::{BTreeMap, HashSet, VecDeque};
+use std::collections::{BTreeMap, HashMap, HashSet, VecDeque};
 use std::f64::consts::PI;
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
@@ -344,14 +344,35 @@ impl ChordMesh {
 /// The dual spanning tree of one simply connected piece of a [`ChordMesh`]: triangles in DFS
 /// preorder, each one's parent and the dual edge to it, and subtree areas.
 ///
-/// `parent` and `sub` are indexed by triangle id (dense vectors over all the mesh's
-/// triangles; entries outside the piece stay `None` / 0): the same values, summed in the same
-/// order, as a map keyed by triangle would hold, without the map's per-entry work.
+/// `parent` and `sub` are aligned with `order` (entry `i` belongs to triangle `order[i]`):
+/// the same values, summed in the same order, as maps keyed by triangle would hold, without
+/// the maps' per-entry work; the per-triangle marks of the traversal live in a
+/// [`TreeScratch`] that is cleared after each tree.
 struct PieceTree {
     order: Vec<usize>,
     parent: Vec<Option<(usize, usize)>>,
     sub: Vec<f64>,
     total: f64,
+}
+
+/// Per-triangle marks for building [`PieceTree`]s of one mesh: whether a triangle was seen,
+/// its parent and its place in the order. All unset between trees.
+struct TreeScratch {
+    seen: Vec<bool>,
+    parent: Vec<Option<(usize, usize)>>,
+    pos: Vec<usize>,
+}
+
+impl TreeScratch {
+    /// Unset marks for the triangles of `m`.
+    fn new(m: &ChordMesh) -> Self {
+        let nt = m.tris.len();
+        Self {
+            seen: vec![false; nt],
+            parent: vec![None; nt],
+            pos: vec![usize::MAX; nt],
+        }
+    }
 }
 
 impl PieceTree {
@@ -361,15 +382,15 @@ impl PieceTree {
         m: &ChordMesh,
         seed: usize,
         open: &dyn Fn(usize, usize) -> Option<usize>,
+        scratch: &mut TreeScratch,
     ) -> Option<Self> {
-        let nt = m.tris.len();
-        let mut parent: Vec<Option<(usize, usize)>> = vec![None; nt];
-        let mut seen = vec![false; nt];
+        let TreeScratch { seen, parent, pos } = scratch;
         seen[seed] = true;
         let mut dfs = vec![seed];
         let mut order = Vec::new();
         let mut dual_edges = 0usize;
         while let Some(x) = dfs.pop() {
+            pos[x] = order.len();
             order.push(x);
             for k in 0..3 {
                 if let Some(u) = open(x, k) {
@@ -382,23 +403,34 @@ impl PieceTree {
                 }
             }
         }
+        let tree_parent: Vec<Option<(usize, usize)>> = order.iter().map(|&x| parent[x]).collect();
+        let tree_pos: Vec<usize> = tree_parent
+            .iter()
+            .map(|p| p.map_or(usize::MAX, |(p, _)| pos[p]))
+            .collect();
+        // clear the marks (a triangle seen is in the order: every one pushed is popped)
+        for &x in &order {
+            seen[x] = false;
+            parent[x] = None;
+            pos[x] = usize::MAX;
+        }
         if dual_edges / 2 + 1 != order.len() {
             return None;
         }
         // children before parents: a triangle's entry holds the sum of its children's
         // subtrees (0.0 + s₁ + s₂ …, in this order) when it is reached
-        let mut sub = vec![0.0; nt];
-        for &x in order.iter().rev() {
-            let s = m.tri_area(x) + sub[x];
-            sub[x] = s;
-            if let Some((p, _)) = parent[x] {
-                sub[p] += s;
+        let mut sub = vec![0.0; order.len()];
+        for i in (0..order.len()).rev() {
+            let s = m.tri_area(order[i]) + sub[i];
+            sub[i] = s;
+            if tree_pos[i] != usize::MAX {
+                sub[tree_pos[i]] += s;
             }
         }
-        let total = sub[seed];
+        let total = sub.first().copied().unwrap_or(0.0);
         Some(Self {
             order,
-            parent,
+            parent: tree_parent,
             sub,
             total,
         })
@@ -410,10 +442,10 @@ impl PieceTree {
         &'a self,
         m: &'a ChordMesh,
     ) -> impl Iterator<Item = (usize, usize, f64, usize)> + 'a {
-        self.order.iter().filter_map(move |&x| {
-            let (p, k) = self.parent[x]?;
+        self.order.iter().enumerate().filter_map(move |(i, &x)| {
+            let (p, k) = self.parent[i]?;
             let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
-            Some((a, b, self.sub[x], x))
+            Some((a, b, self.sub[i], x))
         })
     }
 }
@@ -434,7 +466,7 @@ pub fn neck_score(ring: &[DVec2]) -> f64 {
     if m.tris.is_empty() {
         return 0.0;
     }
-    let Some(tree) = PieceTree::new(&m, 0, &open) else {
+    let Some(tree) = PieceTree::new(&m, 0, &open, &mut TreeScratch::new(&m)) else {
         return f64::NAN;
     };
     tree.chords(&m)
@@ -595,7 +627,7 @@ pub(crate) fn arm_chord(
         return None;
     }
     let open = |t: usize, k: usize| m.nbr[t][k];
-    let tree = PieceTree::new(&m, 0, &open)?;
+    let tree = PieceTree::new(&m, 0, &open, &mut TreeScratch::new(&m))?;
     let min_angle = MIN_END_ANGLE_DEG.to_radians();
     let mut best: Option<(f64, usize, usize)> = None;
     for (a, b, a1, _) in tree.chords(&m) {
@@ -794,14 +826,30 @@ pub(crate) fn layout_cuts(
 
     // 2. transverse cuts in the simply connected pieces
     let nt = m.tris.len();
-    let open = |t: usize, k: usize, cut_set: &HashSet<(usize, usize)>| -> Option<usize> {
-        let u = m.nbr[t][k]?;
-        let (a, b) = (m.tris[t][k], m.tris[t][(k + 1) % 3]);
-        if cut_set.contains(&(a.min(b), a.max(b))) {
-            None
-        } else {
-            Some(u)
+    // the two sides (triangle, edge) of each chord, to close the dual edges across the cuts
+    // (`blocked`, kept with `cut_set`: a pair of samples is one edge of the triangulation,
+    // between two triangles)
+    let mut sides: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
+    for t in 0..nt {
+        for k in 0..3 {
+            if m.nbr[t][k].is_some() {
+                let (a, b) = (m.tris[t][k], m.tris[t][(k + 1) % 3]);
+                sides.entry((a.min(b), a.max(b))).or_default().push((t, k));
+            }
         }
+    }
+    let mut blocked = vec![[false; 3]; nt];
+    let block = |blocked: &mut Vec<[bool; 3]>, pair: &(usize, usize)| {
+        for &(t, k) in sides.get(pair).map(Vec::as_slice).unwrap_or(&[]) {
+            blocked[t][k] = true;
+        }
+    };
+    for pair in &cut_set {
+        block(&mut blocked, pair);
+    }
+    let open = |t: usize, k: usize, blocked: &Vec<[bool; 3]>| -> Option<usize> {
+        let u = m.nbr[t][k]?;
+        (!blocked[t][k]).then_some(u)
     };
     let mut comp = vec![usize::MAX; nt];
     let mut work: Vec<usize> = Vec::new(); // a seed triangle per piece
@@ -812,7 +860,7 @@ pub(crate) fn layout_cuts(
             comp[t] = t;
             while let Some(x) = st.pop() {
                 for k in 0..3 {
-                    if let Some(u) = open(x, k, &cut_set) {
+                    if let Some(u) = open(x, k, &blocked) {
                         if comp[u] == usize::MAX {
                             comp[u] = t;
                             st.push(u);
@@ -823,14 +871,15 @@ pub(crate) fn layout_cuts(
         }
     }
     let budget = 4 * nt + 16;
+    let mut scratch = TreeScratch::new(&m);
     let mut steps = 0;
     while let Some(seed) = work.pop() {
         steps += 1;
         if steps > budget {
             break;
         }
-        let open_here = |t: usize, k: usize| open(t, k, &cut_set);
-        let Some(tree) = PieceTree::new(&m, seed, &open_here) else {
+        let open_here = |t: usize, k: usize| open(t, k, &blocked);
+        let Some(tree) = PieceTree::new(&m, seed, &open_here, &mut scratch) else {
             continue; // not simply connected (should not happen): leave it to Algorithm 1
         };
         let total = tree.total;
@@ -870,6 +919,7 @@ pub(crate) fn layout_cuts(
         }
         if let Some((_, a, b, x)) = best {
             cut_set.insert((a.min(b), a.max(b)));
+            block(&mut blocked, &(a.min(b), a.max(b)));
             order.push((a, b));
             ends.extend([a, b]);
             work.push(seed);
