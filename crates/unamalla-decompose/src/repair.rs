@@ -54,9 +54,10 @@
 //!    lists the joints that remain (none on the fixture regions, tested).
 
 use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
 
 use rayon::prelude::*;
+use unamalla_mesh::geometry::open_segment_hits;
 use unamalla_mesh::DVec2;
 
 use crate::auto::{beyond_best, needs_cut_point, triangle_plan, AngleScreen, Builder};
@@ -401,20 +402,22 @@ impl Host {
     }
 }
 
-/// The new angles at the ends of the candidate cuts of one host ring in tier 1 — at a vertex
-/// towards the cut's other end, and at the foot of a perpendicular from a vertex towards
-/// that vertex, as [`Builder::end_angles`] computes them — each computed once for the split
-/// searches of the host and of its children (the second cuts of a re-split,
-/// [`Builder::best_split3`], search children of the host again and again), or marked as
-/// rejected by the tier's [`AngleScreen`] (then every cut with that end is: the screen
-/// rejects a cut when it rejects an angle at either end).
+/// What the split searches of one host ring and of its children (the second cuts of a
+/// re-split, [`Builder::best_split3`], search children of the host again and again) need to
+/// know about a candidate cut, each computed once: the new angles at its ends in tier 1 — at
+/// a vertex towards the cut's other end, and at the foot of a perpendicular from a vertex
+/// towards that vertex, as [`Builder::end_angles`] computes them — or that the tier's
+/// [`AngleScreen`] rejects one (then every cut with that end is rejected: the screen rejects
+/// a cut when it rejects an angle at either end); and whether the cut is admissible in the
+/// host.
 ///
 /// Exact: a child's vertex that has the host vertex's point and neighbours, bit for bit,
 /// has the same angles towards the same point (the same `atan2` on the same numbers); a
 /// child's edge with a host edge's end points has the same foot of the perpendicular from
 /// the same point (`targets_on_ring` computes it from those three points alone), and the
-/// same angles there. [`EndAngles::locate`] finds those vertices and edges.
-struct EndAngles<'a> {
+/// same angles there. [`CutTable::locate`] finds those vertices and edges. For admissibility
+/// see [`CutTable::admissible`].
+struct CutTable<'a> {
     host: &'a [DVec2],
     /// The screen of tier 1.
     screen: AngleScreen,
@@ -425,13 +428,21 @@ struct EndAngles<'a> {
     /// `[i·n + e]`: the two angles at host vertex `i` towards the foot of its perpendicular
     /// on host edge `e`, then the two at that foot towards vertex `i` (or [`REJECTED`]).
     to_foot: Vec<[AtomicU64; 4]>,
+    /// The host as a piece, and its edge index (built when first needed).
+    piece: Piece,
+    index: std::sync::OnceLock<unamalla_mesh::SegmentIndex>,
+    /// `[i·n + j]`, `[i·n + e]`: whether the cut from host vertex `i` to vertex `j`, or to
+    /// the foot of its perpendicular on edge `e`, is admissible in the host: 0 not known
+    /// yet, 1 no, 2 yes.
+    admits_vertex: Vec<AtomicU8>,
+    admits_foot: Vec<AtomicU8>,
 }
 
-/// The bits an [`EndAngles`] entry starts with when the screen rejects it: those of −1, never
+/// The bits an [`CutTable`] entry starts with when the screen rejects it: those of −1, never
 /// an angle.
 const REJECTED: u64 = 0xbff0_0000_0000_0000;
 
-/// Where the vertices and edges of a ring are those of an [`EndAngles`] host: host vertex
+/// Where the vertices and edges of a ring are those of an [`CutTable`] host: host vertex
 /// of each ring vertex with the same point and neighbours, host edge of each ring edge with
 /// the same end points (`usize::MAX`: none).
 struct HostMatch {
@@ -439,7 +450,7 @@ struct HostMatch {
     edge: Vec<usize>,
 }
 
-impl<'a> EndAngles<'a> {
+impl<'a> CutTable<'a> {
     /// An empty table of `host`'s angles, screened by `screen` (tier 1's).
     fn new(host: &'a [DVec2], screen: AngleScreen) -> Self {
         let n2 = host.len() * host.len();
@@ -448,6 +459,49 @@ impl<'a> EndAngles<'a> {
             screen,
             to_vertex: (0..n2).map(|_| Default::default()).collect(),
             to_foot: (0..n2).map(|_| Default::default()).collect(),
+            piece: Piece {
+                outer: Ring {
+                    pts: host.to_vec(),
+                    tags: vec![Tag::Boundary(0); host.len()],
+                },
+                holes: Vec::new(),
+            },
+            index: std::sync::OnceLock::new(),
+            admits_vertex: (0..n2).map(|_| AtomicU8::new(0)).collect(),
+            admits_foot: (0..n2).map(|_| AtomicU8::new(0)).collect(),
+        }
+    }
+
+    /// Whether the cut from host vertex `i` to `to` (a host vertex, or the foot of the
+    /// perpendicular from vertex `i` on a host edge) is admissible in the host
+    /// ([`Piece::admissible`], computed once).
+    ///
+    /// In a child of the host whose vertex there has the host's neighbours (and whose edge
+    /// holding a foot is the host's), the cut is admissible exactly when it is admissible in
+    /// the host and its open segment meets none of the child's edges that are not host edges
+    /// (the cut that made the child, or part of a host edge it split): the wedges at the ends
+    /// are the same; a segment inside the child is inside the host, meets no child edge and
+    /// so none of those; and a segment inside the host that meets no child edge outside the
+    /// host's stays on one side of the cut, the child's side at its ends.
+    fn admissible(&self, i: usize, to: End) -> bool {
+        let n = self.host.len();
+        let slot = match to.pos {
+            Pos::Vertex(j) => &self.admits_vertex[i * n + j],
+            Pos::OnEdge(e, _) => &self.admits_foot[i * n + e],
+        };
+        match slot.load(Ordering::Relaxed) {
+            1 => false,
+            2 => true,
+            _ => {
+                let idx = self.index.get_or_init(|| self.piece.index());
+                let from = End {
+                    ring: 0,
+                    pos: Pos::Vertex(i),
+                };
+                let a = self.piece.admissible(idx, from, to);
+                slot.store(if a { 2 } else { 1 }, Ordering::Relaxed);
+                a
+            }
         }
     }
 
@@ -719,14 +773,14 @@ impl Builder<'_> {
     ///
     /// `good_only` says that `accept` takes only good blocks ([`Builder::good_fit`], possibly
     /// narrowed): then candidates whose children cannot both be good are not built
-    /// ([`Builder::for_each_split`]); it changes no result. `angles`: the [`EndAngles`] of a
+    /// ([`Builder::for_each_split`]); it changes no result. `angles`: the [`CutTable`] of a
     /// ring that `ring` is a child of (or `ring` itself), if the caller keeps one.
     fn best_split_by(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
-        angles: Option<&EndAngles>,
+        angles: Option<&CutTable>,
     ) -> Option<Split> {
         self.best_split_with(ring, accept, good_only, false, angles)
             .or_else(|| {
@@ -744,7 +798,7 @@ impl Builder<'_> {
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
         quarter_points: bool,
-        angles: Option<&EndAngles>,
+        angles: Option<&CutTable>,
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
         let need = if good_only { 2 } else { 0 };
@@ -793,7 +847,7 @@ impl Builder<'_> {
         quarter_points: bool,
         need: usize,
         bound: Option<&Cell<f64>>,
-        angles: Option<&EndAngles>,
+        angles: Option<&CutTable>,
         visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
     ) {
         let n = ring.len();
@@ -811,46 +865,83 @@ impl Builder<'_> {
             outer: ring.clone(),
             holes: Vec::new(),
         };
-        let idx = piece.index();
+        // the ring's edge index, built if a cut is tested without the table
+        let idx_cell = std::cell::OnceCell::new();
+        let idx = || idx_cell.get_or_init(|| piece.index());
         let sq = piece.area().abs().sqrt().max(1e-300);
         let w = self.opts.cut_weights;
         let mut cands: Vec<(f64, End, End)> = Vec::new();
         let table = angles
             .filter(|_| !quarter_points)
             .map(|t| (t, t.locate(ring)));
+        // the cut from vertex `i` to `e2` in the host's numbering, where the table has it:
+        // the host vertex of `i`, and the host vertex or the foot on a host edge of `e2`
+        let in_host = |i: usize, e2: End| {
+            let (t, at) = table.as_ref()?;
+            let hi = at.vertex[i];
+            if hi == usize::MAX {
+                return None;
+            }
+            let to = match e2.pos {
+                Pos::Vertex(j) if at.vertex[j] != usize::MAX => Pos::Vertex(at.vertex[j]),
+                Pos::OnEdge(e, x) if at.edge[e] != usize::MAX => Pos::OnEdge(at.edge[e], x),
+                _ => return None,
+            };
+            Some((*t, hi, End { ring: 0, pos: to }))
+        };
         // the angle terms of the cut from vertex `i` (as `angle_terms` in tier 1), from the
         // table where it has the angles
         let terms = |i: usize, e2: End| {
-            let from_table = table.as_ref().and_then(|(t, at)| {
-                let hi = at.vertex[i];
-                if hi == usize::MAX {
-                    return None;
-                }
-                match e2.pos {
-                    Pos::Vertex(j) if at.vertex[j] != usize::MAX => {
-                        let hj = at.vertex[j];
-                        Some((hi, None, hj))
-                    }
-                    Pos::OnEdge(e, x) if at.edge[e] != usize::MAX => {
-                        Some((hi, Some(x), at.edge[e]))
-                    }
-                    _ => None,
-                }
-                .map(|(hi, foot, h2)| (t, hi, foot, h2))
-            });
             let e1 = End {
                 ring: 0,
                 pos: Pos::Vertex(i),
             };
             // (a cut the screen rejects at either end gets `None`, as in `angle_terms`)
-            match from_table {
+            match in_host(i, e2) {
                 None => self.angle_terms(&piece, e1, e2, 1),
-                Some((t, hi, None, hj)) => {
+                Some((
+                    t,
+                    hi,
+                    End {
+                        pos: Pos::Vertex(hj),
+                        ..
+                    },
+                )) => {
                     let [a, b] = t.vertex_angles(hi, hj)?;
                     let [c, d] = t.vertex_angles(hj, hi)?;
                     self.angle_terms_of([a, b, c, d], 1)
                 }
-                Some((t, hi, Some(x), he)) => self.angle_terms_of(t.foot_angles(hi, he, x)?, 1),
+                Some((
+                    t,
+                    hi,
+                    End {
+                        pos: Pos::OnEdge(he, x),
+                        ..
+                    },
+                )) => self.angle_terms_of(t.foot_angles(hi, he, x)?, 1),
+            }
+        };
+        // the ring's edges that are not the host's (see `CutTable::admissible`)
+        let not_host: Vec<(DVec2, DVec2)> = table
+            .as_ref()
+            .map(|(_, at)| {
+                (0..n)
+                    .filter(|&k| at.edge[k] == usize::MAX)
+                    .map(|k| (ring.p(k), ring.next(k)))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let admissible = |e1: End, e2: End| {
+            let Pos::Vertex(i) = e1.pos else {
+                return piece.admissible(idx(), e1, e2);
+            };
+            match in_host(i, e2) {
+                Some((t, hi, to)) => {
+                    let (p, q) = (piece.point(e1), piece.point(e2));
+                    t.admissible(hi, to)
+                        && !not_host.iter().any(|&(a, b)| open_segment_hits(p, q, a, b))
+                }
+                None => piece.admissible(idx(), e1, e2),
             }
         };
         // the target list, reused for every start vertex
@@ -916,7 +1007,7 @@ impl Builder<'_> {
             if evaluated >= 80 || bound.is_some_and(|b| beyond_best(pre, b.get())) {
                 return false;
             }
-            if !piece.admissible(&idx, e1, e2) {
+            if !admissible(e1, e2) {
                 return true;
             }
             evaluated += 1;
@@ -940,14 +1031,14 @@ impl Builder<'_> {
     /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
     /// `good_only` as in [`Builder::best_split_by`].
     ///
-    /// `angles` is the [`EndAngles`] table of `ring`, shared by the search of the first cuts
+    /// `angles` is the [`CutTable`] table of `ring`, shared by the search of the first cuts
     /// and the searches of the second cuts in their children.
     fn best_split3(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
-        angles: &EndAngles,
+        angles: &CutTable,
     ) -> Option<Resplit> {
         let mut best: Option<Resplit> = None;
         for quarter_points in [false, true] {
@@ -1183,7 +1274,7 @@ impl Builder<'_> {
                 limit
             };
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
-            let angles = EndAngles::new(&u.pts, *self.tier1_screen());
+            let angles = CutTable::new(&u.pts, *self.tier1_screen());
             let two = matches!(host, Host::Merged2 { .. })
                 .then(|| self.best_split_by(u, &good, true, Some(&angles)))
                 .flatten()
@@ -1676,8 +1767,10 @@ mod tests {
         }
     }
 
-    /// Where `EndAngles::locate` matches a child's vertices and edges to the host's, the
-    /// table's angles are `Builder::end_angles` on the child, bit for bit.
+    /// Where `CutTable::locate` matches a child's vertices and edges to the host's, the
+    /// table's angles are `Builder::end_angles` on the child, bit for bit, and a cut between
+    /// two such vertices is admissible in the child exactly when the table has it admissible
+    /// in the host and it meets none of the child's other edges.
     #[test]
     fn end_angle_table_matches_the_child_angles() {
         let mut state = 0x5eed_1234_abcd_0001u64;
@@ -1688,7 +1781,7 @@ mod tests {
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let bits = |a: [f64; 2]| a.map(f64::to_bits);
-        let mut checked = 0;
+        let (mut checked, mut admitted) = (0, 0);
         for _ in 0..200 {
             let n = 6 + (next() * 30.0) as usize;
             let pts: Vec<DVec2> = (0..n)
@@ -1705,13 +1798,30 @@ mod tests {
             let opts = DecomposeOptions::default();
             let region = l_region();
             let builder = Builder::new(&region, &opts);
-            let table = EndAngles::new(&host.pts, *builder.tier1_screen());
+            let table = CutTable::new(&host.pts, *builder.tier1_screen());
             // a child: the host from vertex i on, closed by a cut to a point inside an edge
             let i = (next() * n as f64) as usize % n;
             let len = 3 + (next() * (n - 4) as f64) as usize;
             let mut child: Vec<DVec2> = (0..len).map(|k| host.pts[(i + k) % n]).collect();
             let (a, b) = (host.pts[(i + len - 1) % n], host.pts[(i + len) % n]);
-            child.push(a + 0.5 * (b - a));
+            let x = a + 0.5 * (b - a);
+            child.push(x);
+            // a child of an admissible cut lies in the host (admissibility is compared there)
+            let host_piece = Piece {
+                outer: host.clone(),
+                holes: Vec::new(),
+            };
+            let cut_ends = [
+                End {
+                    ring: 0,
+                    pos: Pos::OnEdge((i + len - 1) % n, x),
+                },
+                End {
+                    ring: 0,
+                    pos: Pos::Vertex(i),
+                },
+            ];
+            let inside = host_piece.admissible_scan(cut_ends[0], cut_ends[1]);
             let child = Ring {
                 tags: vec![B; child.len()],
                 pts: child,
@@ -1736,6 +1846,25 @@ mod tests {
                         None => assert!(x.min(y) < opts.tolerances.theta_minus),
                     }
                     checked += 1;
+                    // admissibility from the host's and the child's other edges
+                    let idx = piece.index();
+                    let e2 = End {
+                        ring: 0,
+                        pos: Pos::Vertex(l),
+                    };
+                    let to = End {
+                        ring: 0,
+                        pos: Pos::Vertex(at.vertex[l]),
+                    };
+                    let p = child.pts[k];
+                    let hits = (0..m)
+                        .filter(|&f| at.edge[f] == usize::MAX)
+                        .any(|f| open_segment_hits(p, q, child.p(f), child.next(f)));
+                    if inside {
+                        let via_host = table.admissible(at.vertex[k], to) && !hits;
+                        assert_eq!(piece.admissible(&idx, e1, e2), via_host, "{k} {l}");
+                        admitted += via_host as usize;
+                    }
                 }
                 for e in (0..m).filter(|&e| at.edge[e] != usize::MAX) {
                     let (a, b) = (child.p(e), child.next(e));
@@ -1755,6 +1884,7 @@ mod tests {
             }
         }
         assert!(checked > 1000, "{checked}");
+        assert!(admitted > 100, "{admitted}");
     }
 
     #[test]
