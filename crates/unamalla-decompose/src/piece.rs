@@ -236,51 +236,73 @@ impl Piece {
     }
 
     /// The two pieces and the end points of the cut `cut` from `e1` to `e2` (on the outer
-    /// ring): what `insert_ends(e1, e2)` then `split` on a copy of the piece give, built from
-    /// one pass over the ring with the inserted points in place (each right after the vertex
-    /// that starts its edge, as `insert` puts it) instead of the copy and two insertions.
-    /// Both ends inside one edge take the general path.
+    /// ring): what `insert_ends(e1, e2)` then `split` on a copy of the piece give, built for
+    /// a piece without holes by walking the ring from one end to the other ([`Piece::arc`])
+    /// instead of the copy and two insertions. With holes, or both ends inside one edge,
+    /// the general path.
     pub fn split_between(&self, e1: End, e2: End, cut: usize) -> (Piece, Piece, (DVec2, DVec2)) {
-        let on_edge = |e: End| match e.pos {
-            Pos::OnEdge(i, x) => Some((i, x)),
-            Pos::Vertex(_) => None,
-        };
-        let (o1, o2) = (on_edge(e1), on_edge(e2));
-        let one_edge = matches!((o1, o2), (Some((i, _)), Some((j, _))) if i == j);
-        if e1.ring != 0 || e2.ring != 0 || one_edge {
+        let one_edge = matches!(
+            (e1.pos, e2.pos),
+            (Pos::OnEdge(i, _), Pos::OnEdge(j, _)) if i == j
+        );
+        if e1.ring != 0 || e2.ring != 0 || one_edge || !self.holes.is_empty() {
             let mut m = self.clone();
             let (x, y) = m.insert_ends(e1, e2);
             let (a, b) = m.split(x, y, cut);
             return (a, b, (m.outer.p(x), m.outer.p(y)));
         }
+        let piece = |outer| Piece {
+            outer,
+            holes: Vec::new(),
+        };
+        (
+            piece(self.arc(e1, e2, cut)),
+            piece(self.arc(e2, e1, cut)),
+            (self.point(e1), self.point(e2)),
+        )
+    }
+
+    /// The outer ring from `from` forward to `to` (vertices, or points inside edges, taking
+    /// the tags of the edges they lie in), closed by an edge tagged cut `cut`: the child of
+    /// `split` after `insert_ends`, where an inserted point follows the vertex starting its
+    /// edge and continues that edge's tag.
+    fn arc(&self, from: End, to: End, cut: usize) -> Ring {
         let r = &self.outer;
         let n = r.len();
-        let mut pts = Vec::with_capacity(n + 2);
-        let mut tags = Vec::with_capacity(n + 2);
-        let (mut x, mut y) = (0, 0);
-        for k in 0..n {
-            if e1.pos == Pos::Vertex(k) {
-                x = pts.len();
-            }
-            if e2.pos == Pos::Vertex(k) {
-                y = pts.len();
-            }
-            pts.push(r.pts[k]);
-            tags.push(r.tags[k]);
-            for (o, at) in [(o1, &mut x), (o2, &mut y)] {
-                if let Some((i, p)) = o.filter(|&(i, _)| i == k) {
-                    *at = pts.len();
-                    pts.push(p);
-                    tags.push(r.tags[i]);
-                }
-            }
-        }
-        let m = Piece {
-            outer: Ring { pts, tags },
-            holes: self.holes.clone(),
+        // the first vertex of the ring walked, and the last
+        let (first, lead) = match from.pos {
+            Pos::Vertex(i) => (i, None),
+            Pos::OnEdge(i, x) => ((i + 1) % n, Some((x, r.tags[i]))),
         };
-        let (a, b) = m.split(x, y, cut);
-        (a, b, (m.outer.p(x), m.outer.p(y)))
+        let (last, tail) = match to.pos {
+            Pos::Vertex(j) => (j, None),
+            Pos::OnEdge(j, x) => (j, Some(x)),
+        };
+        let len = (last + n - first) % n + 1 + lead.is_some() as usize + tail.is_some() as usize;
+        let mut pts = Vec::with_capacity(len);
+        let mut tags = Vec::with_capacity(len);
+        if let Some((x, t)) = lead {
+            pts.push(x);
+            tags.push(t);
+        }
+        let mut k = first;
+        loop {
+            pts.push(r.pts[k]);
+            if k == last {
+                match tail {
+                    Some(x) => {
+                        tags.push(r.tags[k]);
+                        pts.push(x);
+                        tags.push(Tag::Cut(cut));
+                    }
+                    None => tags.push(Tag::Cut(cut)),
+                }
+                break;
+            }
+            tags.push(r.tags[k]);
+            k = (k + 1) % n;
+        }
+        Ring { pts, tags }
     }
 
     /// Splits the outer ring at vertices `i` and `j` by cut `cut`; holes go to the child that
