@@ -478,6 +478,9 @@ pub fn neck_score(ring: &[DVec2]) -> f64 {
 /// a `min_score` at least this large finds nothing there.
 const ARM_FREE_SCORE: f64 = 3.5;
 
+/// How many pieces [`arm_free`] cuts each of two edges into for its third case.
+const ARM_FREE_PARTS: usize = 8;
+
 /// `true` if no chord of [`arm_chord`]'s triangulation of the block `ring` (a simple ring of
 /// area `area` and perimeter `per`, sampled every `per/400`) with both ends on edges `i`
 /// with `eligible[i]` has a neck score `min(A₁, A₂)/w²` of [`ARM_FREE_SCORE`] or more —
@@ -496,17 +499,23 @@ const ARM_FREE_SCORE: f64 = 3.5;
 ///   `w ≥ (y − x)·u ≥ cos(Θ/2)·|γ| = |γ|/5`, and the side bounded by `γ` has an area of at
 ///   most `(6w)²/(4π) < 2.9·w²`;
 /// * the two edges are farther apart than `R = √(A/6)`: then `w > R`, and the smaller side
-///   has at most `A/2 < 3·w²`.
+///   has at most `A/2 < 3·w²`;
+/// * cut into [`ARM_FREE_PARTS`] equal pieces each, every piece of `e` and piece of `f` are
+///   farther apart than `R`, or the longer of the arcs from one to the other (either way
+///   round: from the start of the one to the end of the other) is shorter than `4.9` times
+///   their distance: then the side bounded by that arc has an area of at most
+///   `(5.9w)²/(4π) < 2.8·w²` (or, as above, `w > R`).
 ///
 /// So every such chord scores below 3. The triangulation computes the score from its
 /// samples (rounded points on the edges) and from sums of rounded triangle areas, and the
 /// test leaves room for that. Consecutive samples are at least `g` apart (the shortest edge,
 /// or a hundredth of the spacing, which [`ChordMesh::new`] keeps between a neck foot and any
 /// other sample), so a chord — its ends are not consecutive samples either way round — is
-/// at least `min(0.4·g, R)` long (under the first case its arc holds two sample gaps). A
-/// sample is off its edge by less than `δ = 4ε·max|coordinate|`, which the test bounds by
-/// 5·10⁻⁸·g (directions and lengths along the samples then differ from the edges' by less
-/// than 10⁻⁷, far inside the margins on `Θ` and `R`). For `N` triangles (at most twice the
+/// at least `min(0.4·g, R)` long (under the first and third cases its arc holds two sample
+/// gaps). A sample (like an end of a piece) is off its edge by less than
+/// `δ = 4ε·max|coordinate|`, which the test bounds by 5·10⁻⁸·g (directions, lengths and
+/// distances along the samples then differ from the edges' by less than 10⁻⁷ relative, far
+/// inside the margins on `Θ`, `R` and the factor 4.9). For `N` triangles (at most twice the
 /// samples: `per/spacing + n` on the edges and at most one neck foot per vertex and nearby
 /// edge), the area error `δ·per + 10·N·ε·per²` (a generous bound of the moved boundary, of
 /// the rounded triangle areas and of their sums) is below `0.4·w²`. The computed score then
@@ -578,9 +587,44 @@ fn arm_free(ring: &[DVec2], eligible: &[bool], area: f64, per: f64) -> bool {
     }
     // Θ, less a margin far above the rounding of the directions
     let theta = 2.0 * 0.2f64.acos() - 1e-6;
+    // arc length along the ring from vertex 0 to each vertex
+    let mut at = vec![0.0; n + 1];
+    for i in 0..n {
+        at[i + 1] = at[i] + edge(i).0.distance(edge(i).1);
+    }
+    // the third case, on edges e < f cut into ARM_FREE_PARTS pieces each: a piece of edge `i`
+    // (end points, arc positions of its ends)
+    let piece = |i: usize, s: usize| {
+        let (a, b) = edge(i);
+        let parts = ARM_FREE_PARTS as f64;
+        let (t0, t1) = (s as f64 / parts, (s + 1) as f64 / parts);
+        let len = at[i + 1] - at[i];
+        (
+            (a + t0 * (b - a), a + t1 * (b - a)),
+            (at[i] + t0 * len, at[i] + t1 * len),
+        )
+    };
+    let pieces_apart = |e: usize, f: usize| {
+        (0..ARM_FREE_PARTS).all(|s| {
+            (0..ARM_FREE_PARTS).all(|t| {
+                let ((a, b), (sa, sb)) = piece(e, s);
+                let ((c, d), (tc, td)) = piece(f, t);
+                let w = point_segment_distance(a, c, d)
+                    .min(point_segment_distance(b, c, d))
+                    .min(point_segment_distance(c, a, b))
+                    .min(point_segment_distance(d, a, b));
+                // the longest arc forward from the piece of e to the piece of f, and back
+                let (forward, back) = (td - sa, per - (tc - sb));
+                w > 1.01 * r || forward.min(back) < 4.9 * w
+            })
+        })
+    };
     (0..n).filter(|&e| eligible[e]).all(|e| {
         (e + 1..n).filter(|&f| eligible[f]).all(|f| {
-            spread[e * n + f] < theta || spread[f * n + e] < theta || dist(e, f) > 1.01 * r
+            spread[e * n + f] < theta
+                || spread[f * n + e] < theta
+                || dist(e, f) > 1.01 * r
+                || pieces_apart(e, f)
         })
     })
 }
