@@ -240,6 +240,50 @@ impl Attempt {
 #[derive(Default)]
 pub(crate) struct RepairCache {
     attempts: std::collections::HashMap<Vec<u64>, Attempt>,
+    /// The candidates of a re-split host ([`Builder::best_resplit`]), keyed by
+    /// [`host_key`], the rings' cut ids numbered as in the key.
+    hosts: std::collections::HashMap<Vec<u64>, Vec<Resplit>>,
+}
+
+/// The key of a re-split host's search: the host ring (points, per edge the region ring or
+/// the cut numbered in the order the cuts first appear), the corner-score limit's bits and
+/// whether the one-cut split is searched too (a union with two neighbours); and the cut ids
+/// in that order.
+///
+/// The search ([`Builder::best_resplit`]'s `candidates`) reads only these — the points and
+/// whether an edge is region boundary or cut, never a cut's id except to copy it to the
+/// children — and the options and minimum area, the same for every builder sharing the
+/// cache: an equal key means the same search up to the cut ids.
+fn host_key(u: &Ring, limit: f64, two: bool) -> (Vec<u64>, Vec<usize>) {
+    let mut key = Vec::new();
+    let mut ids: Vec<usize> = Vec::new();
+    u.push_key(&mut key, |c, key| {
+        let k = ids.iter().position(|&x| x == c).unwrap_or_else(|| {
+            ids.push(c);
+            ids.len() - 1
+        });
+        key.extend([1, k as u64]);
+    });
+    key.extend([limit.to_bits(), two as u64]);
+    (key, ids)
+}
+
+/// `found` with the rings' cut ids mapped by `cut` (placeholders kept); `None` if one has no
+/// image.
+fn relabel_resplits(
+    found: &[Resplit],
+    cut: &dyn Fn(usize) -> Option<usize>,
+) -> Option<Vec<Resplit>> {
+    found
+        .iter()
+        .map(|(s, rings, ends)| {
+            let rings = rings
+                .iter()
+                .map(|r| relabel_ring(r, cut))
+                .collect::<Option<Vec<Ring>>>()?;
+            Some((*s, rings, ends.clone()))
+        })
+        .collect()
 }
 
 /// The neighbourhood of a block that a repair attempt reads: block slot `k`, the blocks
@@ -1273,15 +1317,32 @@ impl Builder<'_> {
             } else {
                 limit
             };
+            let is_two = matches!(host, Host::Merged2 { .. });
+            // the same host searched before (in an earlier sweep or layout): its candidates
+            // (exact, `host_key`)
+            let cache = self.cache.as_ref().map(|c| &c.repair);
+            let (key, ids) = host_key(u, limit, is_two);
+            let hit = cache.and_then(|c| c.lock().ok()?.hosts.get(&key).cloned());
+            if let Some(found) = hit.and_then(|f| relabel_resplits(&f, &|c| ids.get(c).copied())) {
+                return found;
+            }
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
             let angles = CutTable::new(&u.pts, *self.tier1_screen());
-            let two = matches!(host, Host::Merged2 { .. })
+            let two = is_two
                 .then(|| self.best_split_by(u, &good, true, Some(&angles)))
                 .flatten()
                 .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
-            two.into_iter()
+            let found: Vec<Resplit> = two
+                .into_iter()
                 .chain(self.best_split3(u, &good, true, &angles))
-                .collect()
+                .collect();
+            let canon = relabel_resplits(&found, &|c| ids.iter().position(|&x| x == c));
+            if let (Some(cache), Some(canon)) = (cache, canon) {
+                if let Ok(mut c) = cache.lock() {
+                    c.hosts.insert(key, canon);
+                }
+            }
+            found
         };
         // the lowest score wins, candidates compared in host order (as a sequential loop
         // over the hosts would: the searches are pure, the memo only saves work)
