@@ -248,6 +248,7 @@ fn measure(
     let radius = 0.5 * diameter(ring, &hull);
     // the largest pocket measures, folded from 0 over the pockets in order
     let (mut kappa3, mut kappa4) = (0.0f64, 0.0f64);
+    let mut steps: Vec<f64> = Vec::new();
     let h = hull.len();
     for k in 0..h {
         let u = hull[k];
@@ -258,15 +259,21 @@ fn measure(
         }
         let a = ring[u];
         let b = ring[v];
-        // the pocket's arc length from u, summed edge by edge (twice: once for the total,
-        // then again, the same sums, up to each vertex)
-        let step = |s: usize| ring[(u + s) % n].distance(ring[(u + s + 1) % n]);
-        let total = (0..gap).fold(0.0, |acc, s| acc + step(s));
+        // the pocket's edge lengths from u, and its arc length summed edge by edge (for the
+        // total, then again, the same sums, up to each vertex)
+        steps.clear();
+        let mut i = u;
+        for _ in 0..gap {
+            let next = if i + 1 == n { 0 } else { i + 1 };
+            steps.push(ring[i].distance(ring[next]));
+            i = next;
+        }
+        let total = steps.iter().fold(0.0, |acc, &d| acc + d);
         let (mut k3, mut k4) = (0.0f64, 0.0f64);
         let mut along = 0.0;
         for s in 1..gap {
             let i = (u + s) % n;
-            along += step(s - 1);
+            along += steps[s - 1];
             let d3 = if radius > 0.0 {
                 point_segment_distance(ring[i], a, b) / radius
             } else {
