@@ -18,7 +18,7 @@ use crate::error::DecomposeError;
 use crate::geom::{
     angle_penalty, child_hull, child_hull_order, convex_hull, hull_from_order, hull_order,
     left_angle, match_vertices, perimeter, project_t, ray_segment, ring_angle, ring_angles,
-    ring_angles_matched, visit_sorted, HullKey,
+    ring_angles_matched, total_key, visit_sorted, HullKey,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -1585,12 +1585,14 @@ impl<'a> Builder<'a> {
             // the candidates in the order of (pre, coordinates of the second end, position):
             // the sequence a stable sort by pre and coordinates gives, sorted only as far as
             // the search goes (`visit_sorted`)
-            let mut order: Vec<usize> = (0..cands.len()).collect();
-            let cmp = |&ka: &usize, &kb: &usize| {
-                let (a, b) = (&cands[ka], &cands[kb]);
-                a.pre
-                    .total_cmp(&b.pre)
+            // (pre by its `total_cmp` key)
+            let mut order: Vec<(u64, usize)> = (0..cands.len())
+                .map(|k| (total_key(cands[k].pre), k))
+                .collect();
+            let cmp = |&(sa, ka): &(u64, usize), &(sb, kb): &(u64, usize)| {
+                sa.cmp(&sb)
                     .then_with(|| {
+                        let (a, b) = (&cands[ka], &cands[kb]);
                         let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
                         pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
                     })
@@ -1687,7 +1689,7 @@ impl<'a> Builder<'a> {
             };
             let mut pending: Vec<usize> = Vec::with_capacity(chunk);
             let mut going = true;
-            visit_sorted(&mut order, cmp, |&k| {
+            visit_sorted(&mut order, cmp, |&(_, k)| {
                 pending.push(k);
                 if pending.len() < chunk {
                     return true;

@@ -130,7 +130,7 @@ pub(crate) type HullKey = (u64, u64, usize);
 
 /// The key of `v` that orders as `f64::total_cmp` (the bits with the magnitude flipped for
 /// negative numbers, compared as i64), shifted to compare as u64.
-fn total_key(v: f64) -> u64 {
+pub(crate) fn total_key(v: f64) -> u64 {
     let b = v.to_bits() as i64;
     ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
 }

@@ -65,7 +65,7 @@ use crate::concavity::{critical_angles, measures, measures_with_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
-use crate::geom::{left_angle, match_vertices, ring_angles, visit_sorted};
+use crate::geom::{left_angle, match_vertices, ring_angles, total_key, visit_sorted};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
@@ -1031,10 +1031,13 @@ impl Builder<'_> {
         // the candidates in the order of (pre, coordinates of both ends, position): the
         // sequence a stable sort by pre and coordinates gives, sorted only as far as the
         // search goes (`visit_sorted`)
-        let mut order: Vec<(f64, usize)> = (0..cands.len()).map(|k| (cands[k].0, k)).collect();
+        // (pre by its `total_cmp` key)
+        let mut order: Vec<(u64, usize)> = (0..cands.len())
+            .map(|k| (total_key(cands[k].0), k))
+            .collect();
         let mut evaluated = 0;
-        let cmp = |&(sa, ka): &(f64, usize), &(sb, kb): &(f64, usize)| {
-            sa.total_cmp(&sb)
+        let cmp = |&(sa, ka): &(u64, usize), &(sb, kb): &(u64, usize)| {
+            sa.cmp(&sb)
                 .then_with(|| {
                     let (a, b) = (&cands[ka], &cands[kb]);
                     let (pa, pb) = (piece.point(a.1), piece.point(b.1));
