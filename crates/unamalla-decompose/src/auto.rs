@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use unamalla_mesh::{DVec2, Region};
 
-use crate::concavity::{concavity, concavity_with_hull, Tolerances};
+use crate::concavity::{concavity_with_hull, measures, measures_with_hull, Tolerances};
 use crate::corners::{
     quad_fit, quad_fit_with_angles, select_corners, triangle_rule, CornerWeights, TriangleBlock,
 };
@@ -18,7 +18,7 @@ use crate::error::DecomposeError;
 use crate::geom::{
     angle_penalty, child_hull, child_hull_order, convex_hull, hull_from_order, hull_order,
     left_angle, match_vertices, perimeter, project_t, ray_segment, ring_angle, ring_angles,
-    ring_angles_matched, visit_sorted,
+    ring_angles_matched, total_key, visit_sorted, HullKey,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 use crate::repair::RepairCache;
@@ -325,8 +325,85 @@ pub(crate) struct LayoutCache {
     pub repair: Mutex<RepairCache>,
     /// Algorithm 1 on a leaf piece, keyed by [`piece_key`].
     leaf_runs: Mutex<HashMap<Vec<u64>, Arc<LeafRun>>>,
+    /// Algorithm 1 on a piece met inside a run, keyed by [`node_key`] (see
+    /// [`Builder::run_node`]).
+    node_runs: Mutex<HashMap<Vec<u64>, Arc<NodeRun>>>,
     /// The builder after applying each layout's cut list ([`AppliedCuts`]).
     applied: Mutex<Vec<Arc<AppliedCuts>>>,
+    /// The merge pass's tests of blocks and unions.
+    merges: MergeMemo,
+}
+
+/// The merge pass's tests ([`Builder::merge_pass`]), each computed once: pure functions of
+/// the points they are keyed by (and of the options, the same for every builder sharing
+/// them), so a hit returns what the computation would.
+#[derive(Default)]
+pub(crate) struct MergeMemo {
+    /// `quad_fit` of a ring, keyed by its points.
+    fits: Mutex<HashMap<Vec<u64>, f64>>,
+    /// [`MergeMemo::union_fit`], keyed by the two rings' points and cut edges.
+    unions: Mutex<HashMap<Vec<u64>, Option<f64>>>,
+}
+
+/// The bits of `pts`, appended to `key` after their count.
+fn push_points(key: &mut Vec<u64>, pts: &[DVec2]) {
+    key.push(pts.len() as u64);
+    key.extend(pts.iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits()]));
+}
+
+impl MergeMemo {
+    /// `quad_fit(pts)`.
+    fn fit(&self, pts: &[DVec2]) -> f64 {
+        let mut key = Vec::with_capacity(2 * pts.len() + 1);
+        push_points(&mut key, pts);
+        if let Some(&f) = self
+            .fits
+            .lock()
+            .ok()
+            .and_then(|m| m.get(&key).copied())
+            .as_ref()
+        {
+            return f;
+        }
+        let f = quad_fit(pts);
+        if let Ok(mut m) = self.fits.lock() {
+            m.insert(key, f);
+        }
+        f
+    }
+
+    /// The corner score (`quad_fit`) of the union of blocks `a` and `b` across their cut
+    /// edges `ea` and `eb` ([`crate::repair::union_ring`]), if the merge pass may make it: the
+    /// two share exactly two points, and the union is approximately convex without a
+    /// critical angle; `None` otherwise.
+    fn union_fit(&self, tol: &Tolerances, a: &Ring, ea: usize, b: &Ring, eb: usize) -> Option<f64> {
+        let mut key = Vec::with_capacity(2 * (a.len() + b.len()) + 4);
+        push_points(&mut key, &a.pts);
+        key.push(ea as u64);
+        push_points(&mut key, &b.pts);
+        key.push(eb as u64);
+        if let Some(f) = self.unions.lock().ok().and_then(|m| m.get(&key).copied()) {
+            return f;
+        }
+        let f = (|| {
+            let shared = a.pts.iter().filter(|p| b.pts.contains(p)).count();
+            if shared != 2 {
+                return None;
+            }
+            let u = crate::repair::union_ring(a, ea, b, eb)?;
+            let conc = measures(&u.pts);
+            if !conc.approximately_convex(tol)
+                || !crate::concavity::critical_angles(&u.pts, tol.theta_minus).is_empty()
+            {
+                return None;
+            }
+            Some(quad_fit(&u.pts))
+        })();
+        if let Ok(mut m) = self.unions.lock() {
+            m.insert(key, f);
+        }
+        f
+    }
 }
 
 /// A [`Builder`] (of the cache's region and options) right after [`Builder::apply_cut`] of
@@ -358,6 +435,96 @@ fn piece_key(piece: &Piece) -> Vec<u64> {
         r.push_key(&mut key, |c, key| key.extend([1, c as u64]));
     }
     key
+}
+
+/// What Algorithm 1 computes of a ring before cutting it: the vertex angles, the points in
+/// hull order, the convex hull (and whether the points are pairwise different) and the
+/// concavity measures — those of [`concavity`], computed the same way.
+struct Shape {
+    angle: Vec<f64>,
+    hull_keys: Vec<HullKey>,
+    hull: Vec<usize>,
+    distinct: bool,
+    conc: crate::concavity::Concavity,
+}
+
+impl Shape {
+    /// The shape of the ring `pts`.
+    fn of(pts: &[DVec2]) -> Self {
+        let angle = ring_angles(pts);
+        let hull_keys = hull_order(pts);
+        let (hull, distinct) = hull_from_order(pts, &hull_keys);
+        let conc = concavity_with_hull(pts, &angle, hull.clone());
+        Self {
+            angle,
+            hull_keys,
+            hull,
+            distinct,
+            conc,
+        }
+    }
+}
+
+/// The content of a piece up to its cut ids, and those ids: the points, per edge the region
+/// ring or, for a cut, its number in the order the cuts first appear (the piece's rings in
+/// order); the cut ids in that order.
+fn node_key(piece: &Piece) -> (Vec<u64>, Vec<usize>) {
+    let mut key = Vec::new();
+    let mut ids: Vec<usize> = Vec::new();
+    for r in piece.rings() {
+        r.push_key(&mut key, |c, key| {
+            let k = ids.iter().position(|&x| x == c).unwrap_or_else(|| {
+                ids.push(c);
+                ids.len() - 1
+            });
+            key.extend([1, k as u64]);
+        });
+    }
+    (key, ids)
+}
+
+/// `piece` with each cut id `c` replaced by `number(c)`; `Err` if one has no number.
+fn renumber_piece(piece: &Piece, number: &dyn Fn(usize) -> Option<usize>) -> Result<Piece, ()> {
+    let mut p = piece.clone();
+    for r in std::iter::once(&mut p.outer).chain(p.holes.iter_mut()) {
+        for t in &mut r.tags {
+            if let Tag::Cut(c) = t {
+                *c = number(*c).ok_or(())?;
+            }
+        }
+    }
+    Ok(p)
+}
+
+/// Pieces at least this long keep their [`NodeRun`] in the cache (shorter ones are cheap
+/// to cut again).
+const NODE_RUN_MIN_LEN: usize = 16;
+
+/// What Algorithm 1 did on a piece ([`Builder::run_node`]), with the piece's cuts numbered
+/// as in its [`node_key`] and the cuts it made numbered after them, in order.
+pub(crate) struct NodeRun {
+    /// The leaves of the subtree (1: the piece was left whole).
+    leaves: usize,
+    /// The split made on the piece, `None` if it was left whole.
+    split: Option<NodeSplit>,
+}
+
+/// A split of a [`NodeRun`].
+struct NodeSplit {
+    step: Step,
+    /// The new cuts, in the order they were made.
+    cuts: Vec<(DVec2, DVec2)>,
+    /// The two children (the first one of a split by Algorithm 4, the triangle, is left
+    /// whole).
+    children: [ChildRun; 2],
+}
+
+/// A child of a [`NodeSplit`]: its piece if it was left whole (numbered as the parent), the
+/// parent's number of each of its cuts in its own [`node_key`] order, and its run.
+struct ChildRun {
+    piece: Option<Piece>,
+    ids: Vec<usize>,
+    run: Arc<NodeRun>,
 }
 
 /// Algorithm 1 ([`Builder::run_auto`]) on one leaf piece, run in a builder of its own: the
@@ -511,7 +678,7 @@ pub(crate) struct Builder<'a> {
 /// `fl(y/x) > 10⁻⁶` (the true `atan2(y, x)` = −π + atan(y/x) is at least −π + 10⁻⁶·(1 − 10⁻⁶),
 /// so the computed angle, `atan2 + 2π`, is above π + 10⁻⁹).
 #[derive(Clone, Copy, Debug)]
-struct AngleScreen {
+pub(crate) struct AngleScreen {
     /// tan λ·(1 − 10⁻⁹), or 0 (nothing is below) when λ is not in (0, 1.4).
     tan_below: f64,
 }
@@ -534,7 +701,7 @@ impl AngleScreen {
     }
 
     /// `true` only if `left_angle(prev, cur, next)` is below the limit.
-    fn surely_below(&self, prev: DVec2, cur: DVec2, next: DVec2) -> bool {
+    pub(crate) fn surely_below(&self, prev: DVec2, cur: DVec2, next: DVec2) -> bool {
         let (y, x) = Self::yx(prev, cur, next);
         if !(y > 0.0 && x > 0.0) {
             return false;
@@ -549,6 +716,17 @@ impl AngleScreen {
         y < 0.0 && (x >= 0.0 || y / x > 1e-6)
     }
 }
+
+/// What trying a candidate cut of the concavity cut found: not admissible or a child too
+/// small (`Skipped`), or its score.
+enum Trial {
+    Skipped,
+    Score(f64),
+}
+
+/// Pieces at least this long try a few candidate cuts at a time in parallel (shorter ones
+/// run in parallel with the other leaves).
+const PARALLEL_TRIALS_MIN_LEN: usize = 64;
 
 /// Whether a candidate cut whose cheap terms are `pre` (and every later one: the candidates
 /// are sorted by `pre`) cannot beat the best score `best` so far.
@@ -685,8 +863,8 @@ impl<'a> Builder<'a> {
             let (Some(e1), Some(e2)) = (locate(a), locate(b)) else {
                 continue;
             };
-            let idx = piece.index();
-            if !piece.admissible(&idx, e1, e2) {
+            // one test on this piece: a scan of its edges (`admissible_scan`)
+            if !piece.admissible_scan(e1, e2) {
                 continue;
             }
             if e1.ring != 0 && e2.ring != 0 {
@@ -781,7 +959,8 @@ impl<'a> Builder<'a> {
             min_area: self.min_area,
             min_triangle: self.min_triangle,
             auto_repair: self.auto_repair,
-            cache: None,
+            // for the runs of the pieces met inside (`run_node`)
+            cache: self.cache.clone(),
             screens: self.screens,
         };
         b.run_auto(0).ok()?;
@@ -856,49 +1035,165 @@ impl<'a> Builder<'a> {
     }
 
     /// Algorithm 1 on the subtree rooted at `root` (a leaf).
+    ///
+    /// Depth first, child 1 of a split before child 2 (the order of the tree's nodes and of
+    /// the cuts). With a [`LayoutCache`], what it did on a piece is kept ([`NodeRun`]) and
+    /// replayed on a piece with the same content up to its cut ids (exact, see
+    /// [`Builder::run_node`]).
     pub fn run_auto(&mut self, root: usize) -> Result<(), DecomposeError> {
-        let mut stack = vec![root];
-        while let Some(n) = stack.pop() {
-            let Some(piece) = self.pieces[n].clone() else {
-                continue;
-            };
-            if self.leaves() >= self.opts.max_blocks && piece.holes.is_empty() {
-                continue;
+        self.run_node(root).map(|_| ())
+    }
+
+    /// Algorithm 1 on leaf `n` and the leaves its splits make, depth first; the [`NodeRun`]
+    /// of `n`, or `None` where the block budget stopped a split in the subtree (or may have).
+    ///
+    /// A cached run is replayed instead when the piece has the same [`node_key`]: Algorithm 1
+    /// reads the piece's points, the kinds and region rings of its edges and whether an edge
+    /// is a cut, never a cut's id (only to copy it to the children), and the options and
+    /// minimum areas (the same for every builder sharing the cache); the one other thing it
+    /// reads, the leaf count against the block budget, is left out by storing and replaying
+    /// a run only when the budget cannot be reached in it (the leaf count only grows, by the
+    /// run's leaves less one). Replaying makes the same calls in the same order (new cuts,
+    /// then the split), so the nodes, labels and cut ids come out as computing would.
+    fn run_node(&mut self, n: usize) -> Result<Option<Arc<NodeRun>>, DecomposeError> {
+        let Some(piece) = self.pieces[n].clone() else {
+            return Ok(None);
+        };
+        let leaves_before = self.leaves();
+        if leaves_before >= self.opts.max_blocks && piece.holes.is_empty() {
+            return Ok(None);
+        }
+        let within_budget = |run: &NodeRun| leaves_before - 1 + run.leaves < self.opts.max_blocks;
+        let (key, ids) = node_key(&piece);
+        if let Some(memo) = self.cache.as_ref().map(|c| &c.node_runs) {
+            let hit = memo.lock().ok().and_then(|m| m.get(&key).cloned());
+            if let Some(run) = hit.filter(|r| within_budget(r)) {
+                self.replay(n, &run, &ids);
+                return Ok(Some(run));
             }
-            let tol = &self.opts.tolerances;
-            let out = if !piece.holes.is_empty() {
-                let (a, b, c1, c2) = self.remove_hole(&piece)?;
-                Some((Step::HoleRemoval, vec![c1, c2], a, b, true))
-            } else {
-                let conc = concavity(&piece.outer.pts);
-                let mut r = None;
-                if !conc.approximately_convex(tol) {
-                    r = self
-                        .concavity_cut(&piece)
-                        .map(|(a, b, c)| (Step::Concavity, vec![c], a, b, true));
+        }
+        let tol = &self.opts.tolerances;
+        let out = if !piece.holes.is_empty() {
+            let (a, b, c1, c2) = self.remove_hole(&piece)?;
+            Some((Step::HoleRemoval, vec![c1, c2], a, b, true))
+        } else {
+            let shape = Shape::of(&piece.outer.pts);
+            let mut r = None;
+            if !shape.conc.approximately_convex(tol) {
+                r = self
+                    .concavity_cut(&piece, &shape)
+                    .map(|(a, b, c)| (Step::Concavity, vec![c], a, b, true));
+            }
+            if r.is_none() && self.opts.critical_triangles && piece.outer.len() > 3 {
+                r = self
+                    .critical_cut(&piece)
+                    .map(|(a, b, c)| (Step::CriticalAngle, vec![c], a, b, false));
+            }
+            r
+        };
+        let run = match out {
+            None => NodeRun {
+                leaves: 1,
+                split: None,
+            },
+            Some((step, cuts, a, b, both)) => {
+                // this node's numbering of cuts: the piece's, then the new ones
+                let mut numbered = ids.clone();
+                numbered.extend(&cuts);
+                let number = |c: usize| numbered.iter().position(|&x| x == c);
+                let segments = cuts.iter().map(|&c| self.cuts[c]).collect();
+                let child_ids = [&a, &b].map(|p| node_key(p).1);
+                let ids_of = self.branch(n, step, cuts, a, b);
+                // child 1, then child 2 (the triangle of Algorithm 4 is left whole)
+                let first = if both {
+                    self.run_node(ids_of[0])?
+                } else {
+                    Some(Arc::new(NodeRun {
+                        leaves: 1,
+                        split: None,
+                    }))
+                };
+                let second = self.run_node(ids_of[1])?;
+                let (Some(first), Some(second)) = (first, second) else {
+                    return Ok(None);
+                };
+                let mut children = Vec::with_capacity(2);
+                for ((run, id), cids) in [first, second].into_iter().zip(ids_of).zip(child_ids) {
+                    // a child left whole keeps its piece (numbered as this node)
+                    let piece = match (&run.split, &self.pieces[id]) {
+                        (None, Some(p)) => match renumber_piece(p, &|c| number(c)) {
+                            Ok(p) => Some(p),
+                            Err(()) => return Ok(None),
+                        },
+                        _ => None,
+                    };
+                    let Some(ids) = cids.iter().map(|&c| number(c)).collect() else {
+                        return Ok(None);
+                    };
+                    children.push(ChildRun { piece, ids, run });
                 }
-                if r.is_none() && self.opts.critical_triangles && piece.outer.len() > 3 {
-                    r = self
-                        .critical_cut(&piece)
-                        .map(|(a, b, c)| (Step::CriticalAngle, vec![c], a, b, false));
+                let children: [ChildRun; 2] = match children.try_into() {
+                    Ok(c) => c,
+                    Err(_) => return Ok(None),
+                };
+                NodeRun {
+                    leaves: children[0].run.leaves + children[1].run.leaves,
+                    split: Some(NodeSplit {
+                        step,
+                        cuts: segments,
+                        children,
+                    }),
                 }
-                r
-            };
-            if let Some((step, cuts, a, b, both)) = out {
-                let ids = self.branch(n, step, cuts, a, b);
-                // DFS: child 1 first
-                stack.push(ids[1]);
-                if both {
-                    stack.push(ids[0]);
+            }
+        };
+        if !within_budget(&run) {
+            return Ok(None);
+        }
+        let run = Arc::new(run);
+        if let Some(memo) = self.cache.as_ref().map(|c| &c.node_runs) {
+            if piece.outer.len() >= NODE_RUN_MIN_LEN {
+                if let Ok(mut m) = memo.lock() {
+                    m.insert(key, run.clone());
                 }
             }
         }
-        Ok(())
+        Ok(Some(run))
+    }
+
+    /// Replays `run` on leaf `n`, whose piece's cuts in [`node_key`] order are `ids` (the
+    /// run's numbering): the same new cuts, split and runs of the children, in the same order
+    /// as [`Builder::run_node`] made them.
+    fn replay(&mut self, n: usize, run: &NodeRun, ids: &[usize]) {
+        let Some(split) = &run.split else {
+            return;
+        };
+        let mut actual = ids.to_vec();
+        let first_new = actual.len();
+        for &(a, b) in &split.cuts {
+            let c = self.new_cut(a, b);
+            actual.push(c);
+        }
+        let cuts = actual[first_new..].to_vec();
+        let piece = |c: &ChildRun| {
+            c.piece
+                .as_ref()
+                .map(|p| renumber_piece(p, &|k| actual.get(k).copied()))
+                .and_then(Result::ok)
+                .unwrap_or_else(Piece::empty)
+        };
+        let (a, b) = (piece(&split.children[0]), piece(&split.children[1]));
+        let ids_of = self.branch(n, split.step, cuts, a, b);
+        for (c, id) in split.children.iter().zip(ids_of) {
+            if c.run.split.is_some() {
+                let child: Vec<usize> = c.ids.iter().map(|&k| actual[k]).collect();
+                self.replay(id, &c.run, &child);
+            }
+        }
     }
 
     /// The two new angles at a cut end going towards `target`: (angle on the side of the
     /// outgoing edge, angle on the side of the incoming edge).
-    fn end_angles(piece: &Piece, e: End, target: DVec2) -> (f64, f64) {
+    pub(crate) fn end_angles(piece: &Piece, e: End, target: DVec2) -> (f64, f64) {
         let (prev, cur, next) = piece.chain(e);
         (left_angle(target, cur, next), left_angle(prev, cur, target))
     }
@@ -914,25 +1209,43 @@ impl<'a> Builder<'a> {
         e2: End,
         tier: usize,
     ) -> Option<(f64, f64)> {
+        if self.screened_out(piece, e1, e2, tier) {
+            return None;
+        }
+        let (p, q) = (piece.point(e1), piece.point(e2));
+        let (a, b) = Self::end_angles(piece, e1, q);
+        let (c, d) = Self::end_angles(piece, e2, p);
+        self.angle_terms_of([a, b, c, d], tier)
+    }
+
+    /// The [`AngleScreen`] of the angle limit of tier 1 (θ₋), the tier of the repair's
+    /// searches.
+    pub(crate) fn tier1_screen(&self) -> &AngleScreen {
+        &self.screens[0]
+    }
+
+    /// Whether [`AngleScreen`] rejects the candidate cut from `e1` to `e2` in `tier`: a new
+    /// angle surely below the tier's limit, or in tier 0 a reflex angle at `e1` — decisions
+    /// that [`Builder::angle_terms_of`] would reach from the `atan2` angles (exact, see the
+    /// screen), so [`Builder::angle_terms`] returns `None` without computing them.
+    pub(crate) fn screened_out(&self, piece: &Piece, e1: End, e2: End, tier: usize) -> bool {
         let p = piece.point(e1);
         let q = piece.point(e2);
-        // the candidates that a new angle surely below the limit (or, in tier 0, a reflex
-        // angle at `e1`) rejects are rejected before any `atan2` (exact: AngleScreen)
         let screen = &self.screens[tier.saturating_sub(1).min(2)];
         let (prev1, _, next1) = piece.chain(e1);
         let (prev2, _, next2) = piece.chain(e2);
-        if screen.surely_below(q, p, next1)
+        screen.surely_below(q, p, next1)
             || screen.surely_below(prev1, p, q)
             || screen.surely_below(p, q, next2)
             || screen.surely_below(prev2, q, p)
             || (tier == 0
                 && (AngleScreen::surely_reflex(q, p, next1)
                     || AngleScreen::surely_reflex(prev1, p, q)))
-        {
-            return None;
-        }
-        let (a, b) = Self::end_angles(piece, e1, q);
-        let (c, d) = Self::end_angles(piece, e2, p);
+    }
+
+    /// [`Builder::angle_terms`] from the four new angles: `a`, `b` at the first end (as
+    /// [`Builder::end_angles`] gives them towards the second end), `c`, `d` at the second.
+    pub(crate) fn angle_terms_of(&self, [a, b, c, d]: [f64; 4], tier: usize) -> Option<(f64, f64)> {
         let min = a.min(b).min(c).min(d);
         let theta = self.opts.tolerances.theta_minus;
         let limit = match tier {
@@ -1186,7 +1499,7 @@ impl<'a> Builder<'a> {
     /// [`concavity_with_hull`] takes it) are given, for the concavity measures and the corner
     /// score.
     fn badness_with_hull(&self, ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> f64 {
-        let c = concavity_with_hull(ring, angles, hull);
+        let c = measures_with_hull(ring, angles, hull);
         if c.approximately_convex(&self.opts.tolerances) {
             quad_fit_with_angles(ring, angles)
         } else {
@@ -1195,13 +1508,18 @@ impl<'a> Builder<'a> {
     }
 
     /// Algorithm 3: one concavity cut from a deep reflex vertex p to the best q.
-    fn concavity_cut(&mut self, piece: &Piece) -> Option<(Piece, Piece, usize)> {
+    /// `shape` is the [`Shape`] of the piece's outer ring.
+    fn concavity_cut(&mut self, piece: &Piece, shape: &Shape) -> Option<(Piece, Piece, usize)> {
         let ring = &piece.outer;
         let n = ring.len();
-        let angle: Vec<f64> = ring_angles(&ring.pts);
-        let hull_keys = hull_order(&ring.pts);
-        let (hull, distinct) = hull_from_order(&ring.pts, &hull_keys);
-        let conc = concavity_with_hull(&ring.pts, &angle, hull.clone());
+        let Shape {
+            angle,
+            hull_keys,
+            hull,
+            distinct,
+            conc,
+        } = shape;
+        let (hull_keys, hull, distinct) = (hull_keys.as_slice(), hull.as_slice(), *distinct);
         let area = piece.area();
         let sq = area.sqrt();
         let mut starts: Vec<usize> = (0..n)
@@ -1267,45 +1585,39 @@ impl<'a> Builder<'a> {
             // the candidates in the order of (pre, coordinates of the second end, position):
             // the sequence a stable sort by pre and coordinates gives, sorted only as far as
             // the search goes (`visit_sorted`)
-            let mut order: Vec<usize> = (0..cands.len()).collect();
-            let cmp = |&ka: &usize, &kb: &usize| {
-                let (a, b) = (&cands[ka], &cands[kb]);
-                a.pre
-                    .total_cmp(&b.pre)
+            // (pre by its `total_cmp` key)
+            let mut order: Vec<(u64, usize)> = (0..cands.len())
+                .map(|k| (total_key(cands[k].pre), k))
+                .collect();
+            let cmp = |&(sa, ka): &(u64, usize), &(sb, kb): &(u64, usize)| {
+                sa.cmp(&sb)
                     .then_with(|| {
+                        let (a, b) = (&cands[ka], &cands[kb]);
                         let (pa, pb) = (piece.point(a.e2), piece.point(b.e2));
                         pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y))
                     })
                     .then(ka.cmp(&kb))
             };
-            let mut best: Option<(f64, Cand)> = None;
-            let mut evaluated = 0;
-            visit_sorted(&mut order, cmp, |&k| {
-                let c = &cands[k];
-                if evaluated >= 60 {
-                    return false;
-                }
-                // no later candidate can win (exact, see `beyond_best`)
-                if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
-                    return false;
-                }
+            // the trial of a candidate (pure: admissible, both children large enough, their
+            // score); for a large piece a few are tried at a time in parallel and their trials
+            // taken in order as the sequential loop would (one tried beyond where it stops
+            // is work lost, not a different result)
+            let this = &*self;
+            let trial = |c: &Cand| -> Trial {
                 if !piece.admissible(&idx, c.e1, c.e2) {
-                    return true;
+                    return Trial::Skipped;
                 }
-                let mut m = piece.clone();
-                let (x, y) = m.insert_ends(c.e1, c.e2);
-                let (a, b) = m.split(x, y, usize::MAX);
+                let (a, b, _) = piece.split_between(c.e1, c.e2, usize::MAX);
                 let (aa, ab) = (a.area(), b.area());
                 // the last tier also accepts pieces down to a tenth of the negligible area
                 let min_area = if tier == 3 {
-                    0.1 * self.min_area
+                    0.1 * this.min_area
                 } else {
-                    self.min_area
+                    this.min_area
                 };
                 if aa < min_area || ab < min_area {
-                    return true;
+                    return Trial::Skipped;
                 }
-                evaluated += 1;
                 // the children's vertex angles from the piece's where a vertex keeps its
                 // neighbours (exact, `ring_angles_matched`): `a` starts at the cut's first end
                 // (vertex `i` of the piece), `b` at its second end (a vertex, or a point inside
@@ -1318,33 +1630,77 @@ impl<'a> Builder<'a> {
                     Pos::Vertex(i) => i,
                     Pos::OnEdge(e, _) => e + 1,
                 };
-                // and their convex hulls from the piece's: the piece's hull where the child
-                // keeps its vertices (`child_hull`), else from the piece's sorted points for a
-                // large child (`child_hull_order`; both exact, for pairwise different points)
+                // and their convex hulls from the piece's: from the piece's hull vertices
+                // the child keeps and its points beyond them (`child_hull`), else from the
+                // piece's sorted points for a large child (`child_hull_order`; both exact,
+                // for pairwise different points)
                 let badness = |child: &[DVec2], start: usize| {
                     let map = match_vertices(child, &ring.pts, start);
-                    let angles = ring_angles_matched(child, &ring.pts, &angle, &map);
+                    let angles = ring_angles_matched(child, &ring.pts, angle, &map);
                     let large = 8 * child.len() >= n;
                     let hull = distinct
-                        .then(|| child_hull(&ring.pts, &hull, child, &map))
+                        .then(|| child_hull(&ring.pts, hull, child, &map))
                         .flatten()
                         .or_else(|| {
                             let keys = (distinct && large)
-                                .then(|| child_hull_order(&hull_keys, n, child, &map))
+                                .then(|| child_hull_order(hull_keys, n, child, &map))
                                 .flatten()?;
                             Some(hull_from_order(child, &keys).0)
                         })
                         .unwrap_or_else(|| convex_hull(child));
-                    self.badness_with_hull(child, &angles, hull)
+                    this.badness_with_hull(child, &angles, hull)
                 };
                 let ba = badness(&a.outer.pts, start_a);
                 let bb = badness(&b.outer.pts, start_b);
-                let s = 0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre;
-                if best.as_ref().is_none_or(|b| s < b.0) {
-                    best = Some((s, *c));
+                Trial::Score(0.5 * ba.max(bb) + 0.25 * (ba + bb) + c.pre)
+            };
+            let chunk = if n >= PARALLEL_TRIALS_MIN_LEN {
+                rayon::current_num_threads().max(1)
+            } else {
+                1
+            };
+            let mut best: Option<(f64, Cand)> = None;
+            let mut evaluated = 0;
+            // takes the trials of `ks` in order; `false` where the sequential loop stops
+            let mut take = |ks: &[usize]| -> bool {
+                let trials: Vec<Trial> = if ks.len() > 1 {
+                    ks.par_iter().map(|&k| trial(&cands[k])).collect()
+                } else {
+                    ks.iter().map(|&k| trial(&cands[k])).collect()
+                };
+                for (&k, t) in ks.iter().zip(trials) {
+                    let c = &cands[k];
+                    if evaluated >= 60 {
+                        return false;
+                    }
+                    // no later candidate can win (exact, see `beyond_best`)
+                    if best.is_some_and(|(s, _)| beyond_best(c.pre, s)) {
+                        return false;
+                    }
+                    let Trial::Score(s) = t else {
+                        continue;
+                    };
+                    evaluated += 1;
+                    if best.as_ref().is_none_or(|b| s < b.0) {
+                        best = Some((s, *c));
+                    }
                 }
                 true
+            };
+            let mut pending: Vec<usize> = Vec::with_capacity(chunk);
+            let mut going = true;
+            visit_sorted(&mut order, cmp, |&(_, k)| {
+                pending.push(k);
+                if pending.len() < chunk {
+                    return true;
+                }
+                going = take(&pending);
+                pending.clear();
+                going
             });
+            if going && !pending.is_empty() {
+                take(&pending);
+            }
             if let Some((_, c)) = best {
                 let mut m = piece.clone();
                 let (x, y) = m.insert_ends(c.e1, c.e2);
@@ -1484,12 +1840,16 @@ impl<'a> Builder<'a> {
     /// cuts are dropped and the remaining cuts renumbered; leaf nodes of the tree point to the
     /// merged block.
     fn merge_pass(&mut self, rings: Vec<Ring>) -> Vec<Ring> {
-        let tol = self.opts.tolerances;
+        // the tests of blocks and unions, shared with the other layouts of the region (or
+        // kept for this pass's rounds)
+        let cache = self.cache.clone();
+        let local = MergeMemo::default();
+        let memo = cache.as_deref().map_or(&local, |c| &c.merges);
         let mut slot: Vec<Option<Ring>> = rings.into_iter().map(Some).collect();
         let mut owner: Vec<usize> = (0..slot.len()).collect(); // union-find over slots
         let mut fit: Vec<f64> = slot
             .iter()
-            .map(|r| r.as_ref().map_or(0.0, |r| quad_fit(&r.pts)))
+            .map(|r| r.as_ref().map_or(0.0, |r| memo.fit(&r.pts)))
             .collect();
         let mut alive_cut = vec![true; self.cuts.len()];
         loop {
@@ -1513,47 +1873,20 @@ impl<'a> Builder<'a> {
                 let (Some(a), Some(b)) = (&slot[ka], &slot[kb]) else {
                     continue;
                 };
-                // exactly one shared cut and no other shared point
-                let shared = a.pts.iter().filter(|p| b.pts.contains(p)).count();
-                if shared != 2 {
+                // exactly one shared cut and no other shared point; the union approximately
+                // convex and without a critical angle
+                let Some(f) = memo.union_fit(&self.opts.tolerances, a, ea, b, eb) else {
                     continue;
-                }
-                let na = a.len();
-                let nb = b.len();
-                // A: edge ea runs u → v; union = A from v around to u, then B after u to before v
-                let mut pts = Vec::with_capacity(na + nb - 2);
-                let mut tags = Vec::with_capacity(na + nb - 2);
-                for s in 1..=na {
-                    let k = (ea + s) % na;
-                    pts.push(a.pts[k]);
-                    tags.push(if s == na {
-                        b.tags[(eb + 1) % nb]
-                    } else {
-                        a.tags[k]
-                    });
-                }
-                for s in 2..nb {
-                    let k = (eb + s) % nb;
-                    pts.push(b.pts[k]);
-                    tags.push(b.tags[k]);
-                }
-                if pts.len() < 3 || tags.len() != pts.len() {
-                    continue;
-                }
-                let conc = concavity(&pts);
-                if !conc.approximately_convex(&tol)
-                    || !crate::concavity::critical_angles(&pts, tol.theta_minus).is_empty()
-                {
-                    continue;
-                }
-                let f = quad_fit(&pts);
+                };
                 let worst = fit[ka].max(fit[kb]);
                 // a triangle bounded by cuts only could get its fourth corner only inside a cut
                 // (a valence-3 interior node): merge it whenever the union is admissible
                 let cut_triangle =
                     |r: &Ring| r.len() == 3 && r.tags.iter().all(|t| matches!(t, Tag::Cut(_)));
                 if f <= worst + 0.02 || cut_triangle(a) || cut_triangle(b) {
-                    cands.push((worst - f, c, Ring { pts, tags }));
+                    if let Some(u) = crate::repair::union_ring(a, ea, b, eb) {
+                        cands.push((worst - f, c, u));
+                    }
                 }
             }
             if cands.is_empty() {
@@ -1570,7 +1903,7 @@ impl<'a> Builder<'a> {
                 }
                 touched[ka] = true;
                 touched[kb] = true;
-                fit[ka] = quad_fit(&ring.pts);
+                fit[ka] = memo.fit(&ring.pts);
                 slot[ka] = Some(ring);
                 slot[kb] = None;
                 owner[kb] = ka;
@@ -1876,5 +2209,148 @@ pub(crate) fn choose_corners(
             reason: "fewer than four non-reflex vertices and the triangle rule does not apply"
                 .into(),
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A comb: a 14 × 2 base with six 1 × 3 teeth (28 vertices, not approximately convex).
+    fn comb() -> Region {
+        let v = DVec2::new;
+        let mut pts = vec![v(0.0, 0.0), v(14.0, 0.0), v(14.0, 2.0)];
+        for t in (0..6).rev() {
+            let x = 1.0 + 2.0 * t as f64;
+            pts.extend([
+                v(x + 1.5, 2.0),
+                v(x + 1.5, 5.0),
+                v(x + 0.5, 5.0),
+                v(x + 0.5, 2.0),
+            ]);
+        }
+        pts.push(v(0.0, 2.0));
+        Region::new(pts, vec![]).expect("comb")
+    }
+
+    /// A comb with teeth on both sides of a 14 × 2 base (52 vertices).
+    fn double_comb() -> Region {
+        let v = DVec2::new;
+        let mut pts = vec![v(0.0, 0.0)];
+        for t in 0..6 {
+            let x = 1.0 + 2.0 * t as f64;
+            pts.extend([
+                v(x + 0.5, 0.0),
+                v(x + 0.5, -3.0),
+                v(x + 1.5, -3.0),
+                v(x + 1.5, 0.0),
+            ]);
+        }
+        pts.extend([v(14.0, 0.0), v(14.0, 2.0)]);
+        for t in (0..6).rev() {
+            let x = 1.0 + 2.0 * t as f64;
+            pts.extend([
+                v(x + 1.5, 2.0),
+                v(x + 1.5, 5.0),
+                v(x + 0.5, 5.0),
+                v(x + 0.5, 2.0),
+            ]);
+        }
+        pts.push(v(0.0, 2.0));
+        Region::new(pts, vec![]).expect("double comb")
+    }
+
+    /// A star of 20 spikes (40 vertices) around the origin, centred at (7, 1) and scaled so
+    /// that the layout cut of [`run`] crosses it.
+    fn star() -> Region {
+        let pts = (0..40)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / 40.0;
+                let r = if i % 2 == 0 {
+                    6.0
+                } else {
+                    2.5 + 0.1 * (i % 7) as f64
+                };
+                DVec2::new(7.0 + r * t.cos(), 1.0 + r * t.sin())
+            })
+            .collect();
+        Region::new(pts, vec![]).expect("star")
+    }
+
+    /// The state Algorithm 1 leaves in a builder.
+    type State = (Vec<(DVec2, DVec2)>, Vec<TreeNode>, Vec<Option<Piece>>);
+
+    /// Algorithm 1 on the two pieces of `region` after the layout cut `cut`, with `dummies`
+    /// unrelated cuts made first (so that every cut id is shifted by that much).
+    fn run(
+        region: &Region,
+        cut: (DVec2, DVec2),
+        cache: Option<&Arc<LayoutCache>>,
+        dummies: usize,
+    ) -> State {
+        let opts = DecomposeOptions::default();
+        let mut b = Builder::new(region, &opts);
+        b.cache = cache.cloned();
+        for _ in 0..dummies {
+            b.new_cut(DVec2::ZERO, DVec2::ONE);
+        }
+        let tol = crate::decomposition::boundary_tol(region);
+        let applied = b.apply_cut(cut.0, cut.1, tol, Step::Chord);
+        assert_eq!(applied, Applied::Split);
+        for n in [1, 2] {
+            b.run_auto(n).expect("Algorithm 1");
+        }
+        (b.cuts.split_off(dummies), b.nodes, b.pieces)
+    }
+
+    /// `state` with every cut id `c` ≥ `shift` made `c − shift`.
+    fn unshift(state: State, shift: usize) -> State {
+        let (cuts, mut nodes, pieces) = state;
+        for n in &mut nodes {
+            for c in &mut n.cuts {
+                *c -= shift;
+            }
+        }
+        let pieces = pieces
+            .into_iter()
+            .map(|p| p.map(|p| renumber_piece(&p, &|c| c.checked_sub(shift)).expect("ids")))
+            .collect();
+        (cuts, nodes, pieces)
+    }
+
+    /// Runs replayed from the cache (also with other cut ids) give what computing gives; on
+    /// the star some kept runs split both children further.
+    #[test]
+    fn replayed_runs_are_the_computed_ones() {
+        let across = (DVec2::new(7.0, 0.0), DVec2::new(7.0, 2.0));
+        replayed_runs_on(&comb(), across);
+        replayed_runs_on(&double_comb(), across);
+        let star = star();
+        let p = star.outer().points();
+        assert!(replayed_runs_on(&star, (p[1], p[21])) > 0);
+    }
+
+    /// Checks the runs of [`run`] on `region` computed, computed with a cache and replayed
+    /// from it; the number of kept runs that split both children further.
+    fn replayed_runs_on(region: &Region, cut: (DVec2, DVec2)) -> usize {
+        let plain = run(region, cut, None, 0);
+        assert!(plain.0.len() > 4, "{} cuts", plain.0.len());
+        let cache = Arc::new(LayoutCache::default());
+        assert_eq!(run(region, cut, Some(&cache), 0), plain);
+        let split_both = |r: &NodeRun| {
+            r.split
+                .as_ref()
+                .is_some_and(|s| s.children.iter().all(|c| c.run.split.is_some()))
+        };
+        let (stored, both) = cache
+            .node_runs
+            .lock()
+            .map(|m| (m.len(), m.values().filter(|r| split_both(r)).count()))
+            .unwrap_or((0, 0));
+        assert!(stored > 0);
+        // from the cache, on pieces whose cut ids are shifted by three
+        assert_eq!(unshift(run(region, cut, Some(&cache), 3), 3), plain);
+        assert_eq!(run(region, cut, Some(&cache), 0), plain);
+        both
     }
 }

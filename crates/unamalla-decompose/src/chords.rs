@@ -31,7 +31,7 @@
 //! chords making an angle below [`MIN_END_ANGLE_DEG`] with the boundary.
 
 use std::cmp::Ordering::Greater;
-use std::collections::{BTreeMap, HashSet, VecDeque};
+use std::collections::{BTreeMap, HashMap, HashSet, VecDeque};
 use std::f64::consts::PI;
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
@@ -345,14 +345,35 @@ impl ChordMesh {
 /// The dual spanning tree of one simply connected piece of a [`ChordMesh`]: triangles in DFS
 /// preorder, each one's parent and the dual edge to it, and subtree areas.
 ///
-/// `parent` and `sub` are indexed by triangle id (dense vectors over all the mesh's
-/// triangles; entries outside the piece stay `None` / 0): the same values, summed in the same
-/// order, as a map keyed by triangle would hold, without the map's per-entry work.
+/// `parent` and `sub` are aligned with `order` (entry `i` belongs to triangle `order[i]`):
+/// the same values, summed in the same order, as maps keyed by triangle would hold, without
+/// the maps' per-entry work; the per-triangle marks of the traversal live in a
+/// [`TreeScratch`] that is cleared after each tree.
 struct PieceTree {
     order: Vec<usize>,
     parent: Vec<Option<(usize, usize)>>,
     sub: Vec<f64>,
     total: f64,
+}
+
+/// Per-triangle marks for building [`PieceTree`]s of one mesh: whether a triangle was seen,
+/// its parent and its place in the order. All unset between trees.
+struct TreeScratch {
+    seen: Vec<bool>,
+    parent: Vec<Option<(usize, usize)>>,
+    pos: Vec<usize>,
+}
+
+impl TreeScratch {
+    /// Unset marks for the triangles of `m`.
+    fn new(m: &ChordMesh) -> Self {
+        let nt = m.tris.len();
+        Self {
+            seen: vec![false; nt],
+            parent: vec![None; nt],
+            pos: vec![usize::MAX; nt],
+        }
+    }
 }
 
 impl PieceTree {
@@ -362,15 +383,15 @@ impl PieceTree {
         m: &ChordMesh,
         seed: usize,
         open: &dyn Fn(usize, usize) -> Option<usize>,
+        scratch: &mut TreeScratch,
     ) -> Option<Self> {
-        let nt = m.tris.len();
-        let mut parent: Vec<Option<(usize, usize)>> = vec![None; nt];
-        let mut seen = vec![false; nt];
+        let TreeScratch { seen, parent, pos } = scratch;
         seen[seed] = true;
         let mut dfs = vec![seed];
         let mut order = Vec::new();
         let mut dual_edges = 0usize;
         while let Some(x) = dfs.pop() {
+            pos[x] = order.len();
             order.push(x);
             for k in 0..3 {
                 if let Some(u) = open(x, k) {
@@ -383,23 +404,34 @@ impl PieceTree {
                 }
             }
         }
+        let tree_parent: Vec<Option<(usize, usize)>> = order.iter().map(|&x| parent[x]).collect();
+        let tree_pos: Vec<usize> = tree_parent
+            .iter()
+            .map(|p| p.map_or(usize::MAX, |(p, _)| pos[p]))
+            .collect();
+        // clear the marks (a triangle seen is in the order: every one pushed is popped)
+        for &x in &order {
+            seen[x] = false;
+            parent[x] = None;
+            pos[x] = usize::MAX;
+        }
         if dual_edges / 2 + 1 != order.len() {
             return None;
         }
         // children before parents: a triangle's entry holds the sum of its children's
         // subtrees (0.0 + s₁ + s₂ …, in this order) when it is reached
-        let mut sub = vec![0.0; nt];
-        for &x in order.iter().rev() {
-            let s = m.tri_area(x) + sub[x];
-            sub[x] = s;
-            if let Some((p, _)) = parent[x] {
-                sub[p] += s;
+        let mut sub = vec![0.0; order.len()];
+        for i in (0..order.len()).rev() {
+            let s = m.tri_area(order[i]) + sub[i];
+            sub[i] = s;
+            if tree_pos[i] != usize::MAX {
+                sub[tree_pos[i]] += s;
             }
         }
-        let total = sub[seed];
+        let total = sub.first().copied().unwrap_or(0.0);
         Some(Self {
             order,
-            parent,
+            parent: tree_parent,
             sub,
             total,
         })
@@ -411,10 +443,10 @@ impl PieceTree {
         &'a self,
         m: &'a ChordMesh,
     ) -> impl Iterator<Item = (usize, usize, f64, usize)> + 'a {
-        self.order.iter().filter_map(move |&x| {
-            let (p, k) = self.parent[x]?;
+        self.order.iter().enumerate().filter_map(move |(i, &x)| {
+            let (p, k) = self.parent[i]?;
             let (a, b) = (m.tris[p][k], m.tris[p][(k + 1) % 3]);
-            Some((a, b, self.sub[x], x))
+            Some((a, b, self.sub[i], x))
         })
     }
 }
@@ -435,7 +467,7 @@ pub fn neck_score(ring: &[DVec2]) -> f64 {
     if m.tris.is_empty() {
         return 0.0;
     }
-    let Some(tree) = PieceTree::new(&m, 0, &open) else {
+    let Some(tree) = PieceTree::new(&m, 0, &open, &mut TreeScratch::new(&m)) else {
         return f64::NAN;
     };
     tree.chords(&m)
@@ -446,6 +478,9 @@ pub fn neck_score(ring: &[DVec2]) -> f64 {
 /// A neck score that no chord of a block reaches when [`arm_free`] holds: [`arm_chord`] with
 /// a `min_score` at least this large finds nothing there.
 const ARM_FREE_SCORE: f64 = 3.5;
+
+/// How many pieces [`arm_free`] cuts each of two edges into for its third case.
+const ARM_FREE_PARTS: usize = 8;
 
 /// `true` if no chord of [`arm_chord`]'s triangulation of the block `ring` (a simple ring of
 /// area `area` and perimeter `per`, sampled every `per/400`) with both ends on edges `i`
@@ -465,17 +500,23 @@ const ARM_FREE_SCORE: f64 = 3.5;
 ///   `w ≥ (y − x)·u ≥ cos(Θ/2)·|γ| = |γ|/5`, and the side bounded by `γ` has an area of at
 ///   most `(6w)²/(4π) < 2.9·w²`;
 /// * the two edges are farther apart than `R = √(A/6)`: then `w > R`, and the smaller side
-///   has at most `A/2 < 3·w²`.
+///   has at most `A/2 < 3·w²`;
+/// * cut into [`ARM_FREE_PARTS`] equal pieces each, every piece of `e` and piece of `f` are
+///   farther apart than `R`, or the longer of the arcs from one to the other (either way
+///   round: from the start of the one to the end of the other) is shorter than `4.9` times
+///   their distance: then the side bounded by that arc has an area of at most
+///   `(5.9w)²/(4π) < 2.8·w²` (or, as above, `w > R`).
 ///
 /// So every such chord scores below 3. The triangulation computes the score from its
 /// samples (rounded points on the edges) and from sums of rounded triangle areas, and the
 /// test leaves room for that. Consecutive samples are at least `g` apart (the shortest edge,
 /// or a hundredth of the spacing, which [`ChordMesh::new`] keeps between a neck foot and any
 /// other sample), so a chord — its ends are not consecutive samples either way round — is
-/// at least `min(0.4·g, R)` long (under the first case its arc holds two sample gaps). A
-/// sample is off its edge by less than `δ = 4ε·max|coordinate|`, which the test bounds by
-/// 5·10⁻⁸·g (directions and lengths along the samples then differ from the edges' by less
-/// than 10⁻⁷, far inside the margins on `Θ` and `R`). For `N` triangles (at most twice the
+/// at least `min(0.4·g, R)` long (under the first and third cases its arc holds two sample
+/// gaps). A sample (like an end of a piece) is off its edge by less than
+/// `δ = 4ε·max|coordinate|`, which the test bounds by 5·10⁻⁸·g (directions, lengths and
+/// distances along the samples then differ from the edges' by less than 10⁻⁷ relative, far
+/// inside the margins on `Θ`, `R` and the factor 4.9). For `N` triangles (at most twice the
 /// samples: `per/spacing + n` on the edges and at most one neck foot per vertex and nearby
 /// edge), the area error `δ·per + 10·N·ε·per²` (a generous bound of the moved boundary, of
 /// the rounded triangle areas and of their sums) is below `0.4·w²`. The computed score then
@@ -548,9 +589,44 @@ fn arm_free(ring: &[DVec2], eligible: &[bool], area: f64, per: f64) -> bool {
     }
     // Θ, less a margin far above the rounding of the directions
     let theta = 2.0 * 0.2f64.acos() - 1e-6;
+    // arc length along the ring from vertex 0 to each vertex
+    let mut at = vec![0.0; n + 1];
+    for i in 0..n {
+        at[i + 1] = at[i] + edge(i).0.distance(edge(i).1);
+    }
+    // the third case, on edges e < f cut into ARM_FREE_PARTS pieces each: a piece of edge `i`
+    // (end points, arc positions of its ends)
+    let piece = |i: usize, s: usize| {
+        let (a, b) = edge(i);
+        let parts = ARM_FREE_PARTS as f64;
+        let (t0, t1) = (s as f64 / parts, (s + 1) as f64 / parts);
+        let len = at[i + 1] - at[i];
+        (
+            (a + t0 * (b - a), a + t1 * (b - a)),
+            (at[i] + t0 * len, at[i] + t1 * len),
+        )
+    };
+    let pieces_apart = |e: usize, f: usize| {
+        (0..ARM_FREE_PARTS).all(|s| {
+            (0..ARM_FREE_PARTS).all(|t| {
+                let ((a, b), (sa, sb)) = piece(e, s);
+                let ((c, d), (tc, td)) = piece(f, t);
+                let w = point_segment_distance(a, c, d)
+                    .min(point_segment_distance(b, c, d))
+                    .min(point_segment_distance(c, a, b))
+                    .min(point_segment_distance(d, a, b));
+                // the longest arc forward from the piece of e to the piece of f, and back
+                let (forward, back) = (td - sa, per - (tc - sb));
+                w > 1.01 * r || forward.min(back) < 4.9 * w
+            })
+        })
+    };
     (0..n).filter(|&e| eligible[e]).all(|e| {
         (e + 1..n).filter(|&f| eligible[f]).all(|f| {
-            spread[e * n + f] < theta || spread[f * n + e] < theta || dist(e, f) > 1.01 * r
+            spread[e * n + f] < theta
+                || spread[f * n + e] < theta
+                || dist(e, f) > 1.01 * r
+                || pieces_apart(e, f)
         })
     })
 }
@@ -597,7 +673,7 @@ pub(crate) fn arm_chord(
         return None;
     }
     let open = |t: usize, k: usize| m.nbr[t][k];
-    let tree = PieceTree::new(&m, 0, &open)?;
+    let tree = PieceTree::new(&m, 0, &open, &mut TreeScratch::new(&m))?;
     let min_angle = MIN_END_ANGLE_DEG.to_radians();
     let mut best: Option<(f64, usize, usize)> = None;
     for (a, b, a1, _) in tree.chords(&m) {
@@ -796,14 +872,30 @@ pub(crate) fn layout_cuts(
 
     // 2. transverse cuts in the simply connected pieces
     let nt = m.tris.len();
-    let open = |t: usize, k: usize, cut_set: &HashSet<(usize, usize)>| -> Option<usize> {
-        let u = m.nbr[t][k]?;
-        let (a, b) = (m.tris[t][k], m.tris[t][(k + 1) % 3]);
-        if cut_set.contains(&(a.min(b), a.max(b))) {
-            None
-        } else {
-            Some(u)
+    // the two sides (triangle, edge) of each chord, to close the dual edges across the cuts
+    // (`blocked`, kept with `cut_set`: a pair of samples is one edge of the triangulation,
+    // between two triangles)
+    let mut sides: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
+    for t in 0..nt {
+        for k in 0..3 {
+            if m.nbr[t][k].is_some() {
+                let (a, b) = (m.tris[t][k], m.tris[t][(k + 1) % 3]);
+                sides.entry((a.min(b), a.max(b))).or_default().push((t, k));
+            }
         }
+    }
+    let mut blocked = vec![[false; 3]; nt];
+    let block = |blocked: &mut Vec<[bool; 3]>, pair: &(usize, usize)| {
+        for &(t, k) in sides.get(pair).map(Vec::as_slice).unwrap_or(&[]) {
+            blocked[t][k] = true;
+        }
+    };
+    for pair in &cut_set {
+        block(&mut blocked, pair);
+    }
+    let open = |t: usize, k: usize, blocked: &Vec<[bool; 3]>| -> Option<usize> {
+        let u = m.nbr[t][k]?;
+        (!blocked[t][k]).then_some(u)
     };
     let mut comp = vec![usize::MAX; nt];
     let mut work: Vec<usize> = Vec::new(); // a seed triangle per piece
@@ -814,7 +906,7 @@ pub(crate) fn layout_cuts(
             comp[t] = t;
             while let Some(x) = st.pop() {
                 for k in 0..3 {
-                    if let Some(u) = open(x, k, &cut_set) {
+                    if let Some(u) = open(x, k, &blocked) {
                         if comp[u] == usize::MAX {
                             comp[u] = t;
                             st.push(u);
@@ -825,14 +917,15 @@ pub(crate) fn layout_cuts(
         }
     }
     let budget = 4 * nt + 16;
+    let mut scratch = TreeScratch::new(&m);
     let mut steps = 0;
     while let Some(seed) = work.pop() {
         steps += 1;
         if steps > budget {
             break;
         }
-        let open_here = |t: usize, k: usize| open(t, k, &cut_set);
-        let Some(tree) = PieceTree::new(&m, seed, &open_here) else {
+        let open_here = |t: usize, k: usize| open(t, k, &blocked);
+        let Some(tree) = PieceTree::new(&m, seed, &open_here, &mut scratch) else {
             continue; // not simply connected (should not happen): leave it to Algorithm 1
         };
         let total = tree.total;
@@ -872,6 +965,7 @@ pub(crate) fn layout_cuts(
         }
         if let Some((_, a, b, x)) = best {
             cut_set.insert((a.min(b), a.max(b)));
+            block(&mut blocked, &(a.min(b), a.max(b)));
             order.push((a, b));
             ends.extend([a, b]);
             work.push(seed);

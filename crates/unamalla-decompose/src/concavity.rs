@@ -127,6 +127,89 @@ pub(crate) fn concavity_with_angles(ring: &[DVec2], angles: &[f64]) -> Concavity
 /// measures start it at its smallest index).
 pub(crate) fn concavity_with_hull(ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> Concavity {
     let n = ring.len();
+    let mut point_kappa3 = vec![0.0; n];
+    let mut point_kappa4 = vec![0.0; n];
+    let mut pockets = Vec::new();
+    let m = measure(
+        ring,
+        angles,
+        hull,
+        |i, d3, d4| {
+            point_kappa3[i] = d3;
+            point_kappa4[i] = d4;
+        },
+        |(u, v), gap, kappa3, kappa4| {
+            pockets.push(Pocket {
+                bridge: (u, v),
+                vertices: (1..gap).map(|s| (u + s) % n).collect(),
+                kappa3,
+                kappa4,
+            })
+        },
+    );
+    Concavity {
+        kappa1: m.kappa1,
+        kappa2: m.kappa2,
+        kappa3: m.kappa3,
+        kappa4: m.kappa4,
+        pockets,
+        point_kappa3,
+        point_kappa4,
+        max_angle: m.max_angle,
+    }
+}
+
+/// The measures of a [`Concavity`] that approximate convexity reads (κ₁–κ₄ and the largest
+/// angle), without its pockets and point measures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Measures {
+    pub kappa1: f64,
+    pub kappa2: f64,
+    pub kappa3: f64,
+    pub kappa4: f64,
+    pub max_angle: f64,
+}
+
+impl Measures {
+    /// [`Concavity::approximately_convex`] of these measures.
+    pub(crate) fn approximately_convex(&self, tol: &Tolerances) -> bool {
+        self.max_angle <= tol.theta_plus
+            && self.kappa1 <= tol.tau1_minus
+            && self.kappa2 <= tol.tau2_minus
+            && self.kappa3 <= tol.tau3_minus
+            && self.kappa4 <= tol.tau4_minus
+    }
+}
+
+/// The [`Measures`] of [`concavity`] (the same computation).
+pub(crate) fn measures(ring: &[DVec2]) -> Measures {
+    if ring.len() < 3 {
+        return measures_with_angles(ring, &[]);
+    }
+    measures_with_angles(ring, &ring_angles(ring))
+}
+
+/// The [`Measures`] of [`concavity_with_angles`] (the same computation).
+pub(crate) fn measures_with_angles(ring: &[DVec2], angles: &[f64]) -> Measures {
+    measures_with_hull(ring, angles, convex_hull(ring))
+}
+
+/// The [`Measures`] of [`concavity_with_hull`] (the same computation: both call [`measure`]).
+pub(crate) fn measures_with_hull(ring: &[DVec2], angles: &[f64], hull: Vec<usize>) -> Measures {
+    measure(ring, angles, hull, |_, _, _| {}, |_, _, _, _| {})
+}
+
+/// The computation of [`concavity_with_hull`]: the measures, with `point(i, κ₃(i), κ₄(i))`
+/// called for every pocket vertex and `pocket(bridge, gap, κ₃(β), κ₄(β))` for every pocket
+/// (`gap`: ring steps from one bridge end to the other).
+fn measure(
+    ring: &[DVec2],
+    angles: &[f64],
+    hull: Vec<usize>,
+    mut point: impl FnMut(usize, f64, f64),
+    mut pocket: impl FnMut((usize, usize), usize, f64, f64),
+) -> Measures {
+    let n = ring.len();
     let max_angle = if n < 3 {
         0.0
     } else {
@@ -134,17 +217,12 @@ pub(crate) fn concavity_with_hull(ring: &[DVec2], angles: &[f64], hull: Vec<usiz
         angles.iter().copied().fold(0.0, f64::max)
     };
     let mut hull = hull;
-    let mut point_kappa3 = vec![0.0; n];
-    let mut point_kappa4 = vec![0.0; n];
     if n < 3 || hull.len() < 3 {
-        return Concavity {
+        return Measures {
             kappa1: 0.0,
             kappa2: 0.0,
             kappa3: 0.0,
             kappa4: 0.0,
-            pockets: Vec::new(),
-            point_kappa3,
-            point_kappa4,
             max_angle,
         };
     }
@@ -168,7 +246,9 @@ pub(crate) fn concavity_with_hull(ring: &[DVec2], angles: &[f64], hull: Vec<usiz
         0.0
     };
     let radius = 0.5 * diameter(ring, &hull);
-    let mut pockets = Vec::new();
+    // the largest pocket measures, folded from 0 over the pockets in order
+    let (mut kappa3, mut kappa4) = (0.0f64, 0.0f64);
+    let mut steps: Vec<f64> = Vec::new();
     let h = hull.len();
     for k in 0..h {
         let u = hull[k];
@@ -179,51 +259,44 @@ pub(crate) fn concavity_with_hull(ring: &[DVec2], angles: &[f64], hull: Vec<usiz
         }
         let a = ring[u];
         let b = ring[v];
-        let verts: Vec<usize> = (1..gap).map(|s| (u + s) % n).collect();
-        // arc lengths from u along the pocket
-        let mut arc = Vec::with_capacity(gap + 1);
-        let mut acc = 0.0;
-        arc.push(0.0);
-        for s in 0..gap {
-            acc += ring[(u + s) % n].distance(ring[(u + s + 1) % n]);
-            arc.push(acc);
+        // the pocket's edge lengths from u, and its arc length summed edge by edge (for the
+        // total, then again, the same sums, up to each vertex)
+        steps.clear();
+        let mut i = u;
+        for _ in 0..gap {
+            let next = if i + 1 == n { 0 } else { i + 1 };
+            steps.push(ring[i].distance(ring[next]));
+            i = next;
         }
-        let total = acc;
+        let total = steps.iter().fold(0.0, |acc, &d| acc + d);
         let (mut k3, mut k4) = (0.0f64, 0.0f64);
-        for (s, &i) in verts.iter().enumerate() {
+        let mut along = 0.0;
+        for s in 1..gap {
+            let i = (u + s) % n;
+            along += steps[s - 1];
             let d3 = if radius > 0.0 {
                 point_segment_distance(ring[i], a, b) / radius
             } else {
                 0.0
             };
-            let along = arc[s + 1];
             let d4 = if per > 0.0 {
                 along.min(total - along) / per
             } else {
                 0.0
             };
-            point_kappa3[i] = d3;
-            point_kappa4[i] = d4;
+            point(i, d3, d4);
             k3 = k3.max(d3);
             k4 = k4.max(d4);
         }
-        pockets.push(Pocket {
-            bridge: (u, v),
-            vertices: verts,
-            kappa3: k3,
-            kappa4: k4,
-        });
+        pocket((u, v), gap, k3, k4);
+        kappa3 = kappa3.max(k3);
+        kappa4 = kappa4.max(k4);
     }
-    let kappa3 = pockets.iter().map(|p| p.kappa3).fold(0.0, f64::max);
-    let kappa4 = pockets.iter().map(|p| p.kappa4).fold(0.0, f64::max);
-    Concavity {
+    Measures {
         kappa1,
         kappa2,
         kappa3,
         kappa4,
-        pockets,
-        point_kappa3,
-        point_kappa4,
         max_angle,
     }
 }
@@ -315,6 +388,36 @@ mod tests {
             (0.0, 0.0, 0.0, 0.0)
         );
         assert!(is_admissible(&ring, &Tolerances::default()));
+    }
+
+    /// `measures` gives `concavity`'s numbers bit for bit (pseudo-random star-shaped rings,
+    /// deep pockets included).
+    #[test]
+    fn measures_are_the_concavity_numbers() {
+        let mut state = 0xfeed_0123_4567_89abu64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..300 {
+            let n = 3 + (next() * 60.0) as usize;
+            let ring: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * (i as f64 + 0.5 * next()) / n as f64;
+                    let r = 0.2 + next();
+                    v(r * t.cos(), r * t.sin())
+                })
+                .collect();
+            let c = concavity(&ring);
+            let m = measures(&ring);
+            let bits = |x: [f64; 5]| x.map(f64::to_bits);
+            assert_eq!(
+                bits([m.kappa1, m.kappa2, m.kappa3, m.kappa4, m.max_angle]),
+                bits([c.kappa1, c.kappa2, c.kappa3, c.kappa4, c.max_angle])
+            );
+        }
     }
 
     #[test]

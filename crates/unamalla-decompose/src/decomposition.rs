@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use unamalla_mesh::geometry::{open_segment_hits, point_segment_distance};
 use unamalla_mesh::{DVec2, Region, SegmentIndex};
@@ -430,8 +431,9 @@ pub(crate) fn classify(
         }
     }
     check_cuts(region, cuts)?;
-    // blocks: simple, counter-clockwise
-    for b in blocks {
+    // blocks: simple, counter-clockwise (checked in parallel; the first failing block in
+    // order gives the error, as a sequential loop would)
+    let block_ok = |b: &Block| -> Result<(), DecomposeError> {
         if b.ring.len() < 3 {
             return Err(DecomposeError::BlockTooSmall {
                 block: b.id,
@@ -452,7 +454,9 @@ pub(crate) fn classify(
                 edge_b: y.edge,
             });
         }
-    }
+        Ok(())
+    };
+    first_error(blocks.par_iter().map(block_ok).collect())?;
     // edges: cut or boundary
     let key = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
     let mut cut_map: HashMap<(PointKey, PointKey), usize> = HashMap::new();
@@ -462,18 +466,23 @@ pub(crate) fn classify(
     }
     let rings: Vec<&[DVec2]> = region.rings().map(|p| p.points()).collect();
     let index = region.edge_index();
-    let mut uses: Vec<Vec<(usize, DVec2)>> = vec![Vec::new(); cuts.len()];
-    // per region edge: (t of start, start, end)
-    let mut cover: HashMap<(usize, usize), CoverList> = HashMap::new();
-    let mut kinds: Vec<Vec<Option<(bool, usize)>>> = Vec::with_capacity(blocks.len());
-    for b in blocks {
+    // each block's edges, in parallel: the kinds, the cuts used (cut, start point) and the
+    // region edges covered ((ring, edge), (t of start, start, end)); gathered in block
+    // order below, as a sequential loop would record them
+    type BlockEdges = (
+        Vec<Option<(bool, usize)>>,
+        Vec<(usize, DVec2)>,
+        Vec<((usize, usize), (f64, DVec2, DVec2))>,
+    );
+    let block_edges = |b: &Block| -> Result<BlockEdges, DecomposeError> {
         let n = b.ring.len();
         let mut ks = Vec::with_capacity(n);
+        let (mut used, mut covered) = (Vec::new(), Vec::new());
         for e in 0..n {
             let u = b.ring[e];
             let v = b.ring[(e + 1) % n];
             if let Some(&c) = cut_map.get(&(key(u), key(v))) {
-                uses[c].push((b.id, u));
+                used.push((c, u));
                 ks.push(Some((true, c)));
                 continue;
             }
@@ -504,8 +513,24 @@ pub(crate) fn classify(
             };
             let (a, bb) = index.edge(er);
             let t = crate::geom::project_t(u, a, bb);
-            cover.entry((er.ring, er.edge)).or_default().push((t, u, v));
+            covered.push(((er.ring, er.edge), (t, u, v)));
             ks.push(Some((false, er.ring)));
+        }
+        Ok((ks, used, covered))
+    };
+    let per_block: Vec<Result<BlockEdges, DecomposeError>> =
+        blocks.par_iter().map(block_edges).collect();
+    let mut uses: Vec<Vec<(usize, DVec2)>> = vec![Vec::new(); cuts.len()];
+    // per region edge: (t of start, start, end)
+    let mut cover: HashMap<(usize, usize), CoverList> = HashMap::new();
+    let mut kinds: Vec<Vec<Option<(bool, usize)>>> = Vec::with_capacity(blocks.len());
+    for (b, r) in blocks.iter().zip(per_block) {
+        let (ks, used, covered) = r?;
+        for (c, u) in used {
+            uses[c].push((b.id, u));
+        }
+        for (edge, entry) in covered {
+            cover.entry(edge).or_default().push(entry);
         }
         kinds.push(ks);
     }
@@ -585,12 +610,20 @@ pub(crate) fn classify(
     ))
 }
 
+/// The first error of `results` (in order), as a loop stopping there would return it.
+fn first_error(results: Vec<Result<(), DecomposeError>>) -> Result<(), DecomposeError> {
+    results.into_iter().collect()
+}
+
 /// Cuts: finite, endpoints on the boundary (or at a joint shared with another cut, where the
 /// triangle-block rule split a cut), inside the region, pairwise disjoint.
 pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeError> {
     let tol = boundary_tol(region);
     let index = region.edge_index();
-    for c in cuts {
+    let max_x = region.bounding_box().1.x;
+    // each cut on its own, in parallel; the first failing cut in order gives the error, as a
+    // sequential loop would
+    let cut_ok = |c: &Cut| -> Result<(), DecomposeError> {
         for (name, p) in [('a', c.a), ('b', c.b)] {
             if !p.is_finite() {
                 return Err(DecomposeError::NonFinite {
@@ -636,16 +669,18 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
             .min(0.25);
         let a2 = c.a + shrink * d;
         let b2 = c.b - shrink * d;
-        if !(contains_point_with(region, &index, a2)
-            && contains_point_with(region, &index, b2)
+        if !(contains_point_with(region, &index, max_x, a2)
+            && contains_point_with(region, &index, max_x, b2)
             && !index.open_segment_blocked(a2, b2))
         {
             return Err(err);
         }
-    }
+        Ok(())
+    };
+    first_error(cuts.par_iter().map(cut_ok).collect())?;
     if cuts.len() > 1 {
         let cut_index = SegmentIndex::new(cuts.iter().map(|c| vec![c.a, c.b]).collect());
-        for c in cuts {
+        let disjoint = |c: &Cut| -> Result<(), DecomposeError> {
             for er in cut_index.candidates(c.a, c.b) {
                 if er.ring == c.id {
                     continue;
@@ -658,14 +693,17 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
                     });
                 }
             }
-        }
+            Ok(())
+        };
+        first_error(cuts.par_iter().map(disjoint).collect())?;
     }
     Ok(())
 }
 
 /// [`Region::contains_point`] (`p` in the open region) with `index` =
-/// [`Region::edge_index`] of `region`, looking only at the edges whose bounding box meets the
-/// horizontal ray from `p` to the right.
+/// [`Region::edge_index`] of `region` and `max_x` the largest `x` of its bounding box,
+/// looking only at the edges whose bounding box meets the horizontal ray from `p` to the
+/// right (up to `max_x`).
 ///
 /// The same answer: `contains_point` locates `p` in each ring by the winding number of
 /// `locate_in_ring` (an edge counts +1 if it goes up across the height of `p` with `p`
@@ -676,10 +714,14 @@ pub(crate) fn check_cuts(region: &Region, cuts: &[Cut]) -> Result<(), DecomposeE
 /// The rules are evaluated here on the same numbers with the same predicates. `p` is inside
 /// exactly when it is on no edge, the outer ring's winding number is not 0 and every hole's
 /// is (a point inside a hole or on any ring is not in the open region).
-pub(crate) fn contains_point_with(region: &Region, index: &SegmentIndex, p: DVec2) -> bool {
-    let (_, hi) = region.bounding_box();
+pub(crate) fn contains_point_with(
+    region: &Region,
+    index: &SegmentIndex,
+    max_x: f64,
+    p: DVec2,
+) -> bool {
     let mut winding = vec![0i64; region.rings().count()];
-    for er in index.candidates(p, DVec2::new(hi.x, p.y)) {
+    for er in index.candidates(p, DVec2::new(max_x, p.y)) {
         let (a, b) = index.edge(er);
         let o = unamalla_mesh::geometry::orient2d(a, b, p);
         if o == 0.0 && unamalla_mesh::geometry::point_on_segment(a, b, p) {
@@ -778,7 +820,7 @@ mod tests {
         }
         for p in points {
             assert_eq!(
-                contains_point_with(&region, &index, p),
+                contains_point_with(&region, &index, region.bounding_box().1.x, p),
                 region.contains_point(p),
                 "{p:?}"
             );

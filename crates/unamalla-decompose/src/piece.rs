@@ -78,6 +78,16 @@ pub(crate) struct End {
 }
 
 impl Piece {
+    /// A piece without points (a placeholder for a child that is split at once).
+    pub fn empty() -> Self {
+        Piece {
+            outer: Ring {
+                pts: Vec::new(),
+                tags: Vec::new(),
+            },
+            holes: Vec::new(),
+        }
+    }
     pub fn ring(&self, k: usize) -> &Ring {
         if k == 0 {
             &self.outer
@@ -120,6 +130,39 @@ impl Piece {
     /// the segment leaves each endpoint into the region-side wedge and its open part meets no
     /// edge. Endpoints inside edges are checked against the two half-edges they create.
     pub fn admissible(&self, idx: &SegmentIndex, e1: End, e2: End) -> bool {
+        self.admissible_near(e1, e2, &|p, q, test| {
+            idx.candidates(p, q)
+                .all(|er| test((er.ring, er.edge), idx.edge(er)))
+        })
+    }
+
+    /// [`Piece::admissible`] without an index, for a single test: the piece's edges are
+    /// scanned, those whose bounding box misses the segment's skipped (the index's
+    /// candidates are those whose box meets it; the others cannot meet the segment), so the
+    /// same edges decide.
+    pub fn admissible_scan(&self, e1: End, e2: End) -> bool {
+        self.admissible_near(e1, e2, &|p, q, test| {
+            let (lo, hi) = (p.min(q), p.max(q));
+            self.rings().enumerate().all(|(r, ring)| {
+                (0..ring.len()).all(|i| {
+                    let (a, b) = (ring.p(i), ring.next(i));
+                    let apart = a.max(b).cmplt(lo).any() || a.min(b).cmpgt(hi).any();
+                    apart || test((r, i), (a, b))
+                })
+            })
+        })
+    }
+
+    /// [`Piece::admissible`] with the edges that may meet the open segment `pq`: `near(p, q,
+    /// test)` calls `test((ring, edge), (start, end))` on each of them (at least) while it
+    /// returns `true`, and says whether all passed.
+    #[allow(clippy::type_complexity)]
+    fn admissible_near(
+        &self,
+        e1: End,
+        e2: End,
+        near: &dyn Fn(DVec2, DVec2, &mut dyn FnMut((usize, usize), (DVec2, DVec2)) -> bool) -> bool,
+    ) -> bool {
         let p = self.point(e1);
         let q = self.point(e2);
         if p == q {
@@ -139,15 +182,11 @@ impl Piece {
         if h1.is_some() && h1 == h2 {
             return false;
         }
-        for er in idx.candidates(p, q) {
-            let key = Some((er.ring, er.edge));
-            if key == h1 || key == h2 {
-                continue;
-            }
-            let (a, b) = idx.edge(er);
-            if open_segment_hits(p, q, a, b) {
-                return false;
-            }
+        let clear = near(p, q, &mut |key, (a, b)| {
+            Some(key) == h1 || Some(key) == h2 || !open_segment_hits(p, q, a, b)
+        });
+        if !clear {
+            return false;
         }
         for (e, h) in [(e1, h1), (e2, h2)] {
             if let Some((r, i)) = h {
@@ -194,6 +233,76 @@ impl Piece {
                 i + 1
             }
         }
+    }
+
+    /// The two pieces and the end points of the cut `cut` from `e1` to `e2` (on the outer
+    /// ring): what `insert_ends(e1, e2)` then `split` on a copy of the piece give, built for
+    /// a piece without holes by walking the ring from one end to the other ([`Piece::arc`])
+    /// instead of the copy and two insertions. With holes, or both ends inside one edge,
+    /// the general path.
+    pub fn split_between(&self, e1: End, e2: End, cut: usize) -> (Piece, Piece, (DVec2, DVec2)) {
+        let one_edge = matches!(
+            (e1.pos, e2.pos),
+            (Pos::OnEdge(i, _), Pos::OnEdge(j, _)) if i == j
+        );
+        if e1.ring != 0 || e2.ring != 0 || one_edge || !self.holes.is_empty() {
+            let mut m = self.clone();
+            let (x, y) = m.insert_ends(e1, e2);
+            let (a, b) = m.split(x, y, cut);
+            return (a, b, (m.outer.p(x), m.outer.p(y)));
+        }
+        let piece = |outer| Piece {
+            outer,
+            holes: Vec::new(),
+        };
+        (
+            piece(self.arc(e1, e2, cut)),
+            piece(self.arc(e2, e1, cut)),
+            (self.point(e1), self.point(e2)),
+        )
+    }
+
+    /// The outer ring from `from` forward to `to` (vertices, or points inside edges, taking
+    /// the tags of the edges they lie in), closed by an edge tagged cut `cut`: the child of
+    /// `split` after `insert_ends`, where an inserted point follows the vertex starting its
+    /// edge and continues that edge's tag.
+    fn arc(&self, from: End, to: End, cut: usize) -> Ring {
+        let r = &self.outer;
+        let n = r.len();
+        // the first vertex of the ring walked, and the last
+        let (first, lead) = match from.pos {
+            Pos::Vertex(i) => (i, None),
+            Pos::OnEdge(i, x) => ((i + 1) % n, Some((x, r.tags[i]))),
+        };
+        let (last, tail) = match to.pos {
+            Pos::Vertex(j) => (j, None),
+            Pos::OnEdge(j, x) => (j, Some(x)),
+        };
+        let len = (last + n - first) % n + 1 + lead.is_some() as usize + tail.is_some() as usize;
+        let mut pts = Vec::with_capacity(len);
+        let mut tags = Vec::with_capacity(len);
+        if let Some((x, t)) = lead {
+            pts.push(x);
+            tags.push(t);
+        }
+        let mut k = first;
+        loop {
+            pts.push(r.pts[k]);
+            if k == last {
+                match tail {
+                    Some(x) => {
+                        tags.push(r.tags[k]);
+                        pts.push(x);
+                        tags.push(Tag::Cut(cut));
+                    }
+                    None => tags.push(Tag::Cut(cut)),
+                }
+                break;
+            }
+            tags.push(r.tags[k]);
+            k = (k + 1) % n;
+        }
+        Ring { pts, tags }
     }
 
     /// Splits the outer ring at vertices `i` and `j` by cut `cut`; holes go to the child that
@@ -292,6 +401,83 @@ mod tests {
                 pts: hole,
             }],
         }
+    }
+
+    /// `split_between` gives what a copy with `insert_ends` and `split` gives, for every pair
+    /// of ends (vertices, points inside edges) of a hexagon.
+    #[test]
+    fn split_between_matches_insert_then_split() {
+        let pts = vec![
+            v(0., 0.),
+            v(2., -1.),
+            v(4., 0.),
+            v(4., 3.),
+            v(2., 4.),
+            v(0., 3.),
+        ];
+        let n = pts.len();
+        let piece = Piece {
+            outer: Ring {
+                tags: (0..n)
+                    .map(|i| {
+                        if i % 2 == 0 {
+                            Tag::Boundary(0)
+                        } else {
+                            Tag::Cut(i)
+                        }
+                    })
+                    .collect(),
+                pts: pts.clone(),
+            },
+            holes: Vec::new(),
+        };
+        let ends: Vec<End> = (0..n)
+            .flat_map(|i| {
+                let (a, b) = (pts[i], pts[(i + 1) % n]);
+                [Pos::Vertex(i), Pos::OnEdge(i, a + 0.3 * (b - a))]
+            })
+            .map(|pos| End { ring: 0, pos })
+            .collect();
+        for &e1 in &ends {
+            for &e2 in &ends {
+                if e1 == e2 {
+                    continue;
+                }
+                let mut m = piece.clone();
+                let (x, y) = m.insert_ends(e1, e2);
+                let (a, b) = m.split(x, y, 99);
+                let want = (a, b, (m.outer.p(x), m.outer.p(y)));
+                assert_eq!(piece.split_between(e1, e2, 99), want, "{e1:?} {e2:?}");
+            }
+        }
+    }
+
+    /// `admissible_scan` answers as `admissible` with an index, for every pair of ends
+    /// (vertices, points inside edges) of a square with a square hole.
+    #[test]
+    fn scanned_admissibility_matches_the_indexed_one() {
+        let p = square_with_hole();
+        let idx = p.index();
+        let ends: Vec<End> = p
+            .rings()
+            .enumerate()
+            .flat_map(|(r, ring)| {
+                (0..ring.len()).flat_map(move |i| {
+                    let (a, b) = (ring.p(i), ring.next(i));
+                    [Pos::Vertex(i), Pos::OnEdge(i, a + 0.5 * (b - a))]
+                        .map(|pos| End { ring: r, pos })
+                })
+            })
+            .collect();
+        let mut admitted = 0;
+        for &e1 in &ends {
+            for &e2 in &ends {
+                let want = p.admissible(&idx, e1, e2);
+                assert_eq!(p.admissible_scan(e1, e2), want, "{e1:?} {e2:?}");
+                admitted += want as usize;
+            }
+        }
+        assert!(admitted > 10, "{admitted}");
     }
 
     #[test]

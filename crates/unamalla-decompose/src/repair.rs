@@ -54,16 +54,18 @@
 //!    lists the joints that remain (none on the fixture regions, tested).
 
 use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
 
 use rayon::prelude::*;
+use unamalla_mesh::geometry::open_segment_hits;
 use unamalla_mesh::DVec2;
 
-use crate::auto::{beyond_best, needs_cut_point, triangle_plan, Builder};
-use crate::concavity::{concavity, concavity_with_angles, critical_angles};
+use crate::auto::{beyond_best, needs_cut_point, triangle_plan, AngleScreen, Builder};
+use crate::concavity::{critical_angles, measures, measures_with_angles};
 use crate::corners::{has_four_corners, quad_fit, quad_fit_with_angles, select_corners};
 use crate::corners_diametral::CornerChoice;
 use crate::decomposition::{Step, TreeNode};
-use crate::geom::{ring_angles, visit_sorted};
+use crate::geom::{left_angle, match_vertices, ring_angles, total_key, visit_sorted};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
 
 /// Placeholder cut id used while a candidate split is evaluated.
@@ -238,6 +240,50 @@ impl Attempt {
 #[derive(Default)]
 pub(crate) struct RepairCache {
     attempts: std::collections::HashMap<Vec<u64>, Attempt>,
+    /// The candidates of a re-split host ([`Builder::best_resplit`]), keyed by
+    /// [`host_key`], the rings' cut ids numbered as in the key.
+    hosts: std::collections::HashMap<Vec<u64>, Vec<Resplit>>,
+}
+
+/// The key of a re-split host's search: the host ring (points, per edge the region ring or
+/// the cut numbered in the order the cuts first appear), the corner-score limit's bits and
+/// whether the one-cut split is searched too (a union with two neighbours); and the cut ids
+/// in that order.
+///
+/// The search ([`Builder::best_resplit`]'s `candidates`) reads only these — the points and
+/// whether an edge is region boundary or cut, never a cut's id except to copy it to the
+/// children — and the options and minimum area, the same for every builder sharing the
+/// cache: an equal key means the same search up to the cut ids.
+fn host_key(u: &Ring, limit: f64, two: bool) -> (Vec<u64>, Vec<usize>) {
+    let mut key = Vec::new();
+    let mut ids: Vec<usize> = Vec::new();
+    u.push_key(&mut key, |c, key| {
+        let k = ids.iter().position(|&x| x == c).unwrap_or_else(|| {
+            ids.push(c);
+            ids.len() - 1
+        });
+        key.extend([1, k as u64]);
+    });
+    key.extend([limit.to_bits(), two as u64]);
+    (key, ids)
+}
+
+/// `found` with the rings' cut ids mapped by `cut` (placeholders kept); `None` if one has no
+/// image.
+fn relabel_resplits(
+    found: &[Resplit],
+    cut: &dyn Fn(usize) -> Option<usize>,
+) -> Option<Vec<Resplit>> {
+    found
+        .iter()
+        .map(|(s, rings, ends)| {
+            let rings = rings
+                .iter()
+                .map(|r| relabel_ring(r, cut))
+                .collect::<Option<Vec<Ring>>>()?;
+            Some((*s, rings, ends.clone()))
+        })
+        .collect()
 }
 
 /// The neighbourhood of a block that a repair attempt reads: block slot `k`, the blocks
@@ -345,18 +391,17 @@ type FitEntry = (Box<[DVec2]>, Option<f64>);
 impl FitMemo {
     /// `b.good_fit(ring)`, computed once per vertex sequence.
     fn good_fit(&self, b: &Builder<'_>, ring: &Ring) -> Option<f64> {
-        use std::hash::{Hash, Hasher};
         let same = |p: &[DVec2]| {
             p.len() == ring.pts.len()
                 && p.iter()
                     .zip(&ring.pts)
                     .all(|(a, b)| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits())
         };
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        for p in &ring.pts {
-            (p.x.to_bits(), p.y.to_bits()).hash(&mut h);
-        }
-        let h = h.finish();
+        // the bucket: a quick hash of the coordinates' bits (FxHash's multiply and rotate;
+        // the entries in a bucket are told apart by the full sequence)
+        const K: u64 = 0x517c_c1b7_2722_0a95;
+        let mix = |h: u64, x: f64| (h.rotate_left(5) ^ x.to_bits()).wrapping_mul(K);
+        let h = ring.pts.iter().fold(0u64, |h, p| mix(mix(h, p.x), p.y));
         if let Ok(m) = self.0.lock() {
             if let Some(f) = m.get(&h).and_then(|v| v.iter().find(|e| same(&e.0))) {
                 return f.1;
@@ -398,6 +443,213 @@ impl Host {
             Host::Merged { j, c } => (vec![k, j], vec![c]),
             Host::Merged2 { j, c, j2, c2 } => (vec![k, j, j2], vec![c, c2]),
         }
+    }
+}
+
+/// What the split searches of one host ring and of its children (the second cuts of a
+/// re-split, [`Builder::best_split3`], search children of the host again and again) need to
+/// know about a candidate cut, each computed once: the new angles at its ends in tier 1 — at
+/// a vertex towards the cut's other end, and at the foot of a perpendicular from a vertex
+/// towards that vertex, as [`Builder::end_angles`] computes them — or that the tier's
+/// [`AngleScreen`] rejects one (then every cut with that end is rejected: the screen rejects
+/// a cut when it rejects an angle at either end); and whether the cut is admissible in the
+/// host.
+///
+/// Exact: a child's vertex that has the host vertex's point and neighbours, bit for bit,
+/// has the same angles towards the same point (the same `atan2` on the same numbers); a
+/// child's edge with a host edge's end points has the same foot of the perpendicular from
+/// the same point (`targets_on_ring` computes it from those three points alone), and the
+/// same angles there. [`CutTable::locate`] finds those vertices and edges. For admissibility
+/// see [`CutTable::admissible`].
+struct CutTable<'a> {
+    host: &'a [DVec2],
+    /// The screen of tier 1.
+    screen: AngleScreen,
+    /// `[i·n + j]`: the two angles at host vertex `i` towards host vertex `j`, as bits;
+    /// 0 while not computed (an angle is in (0, 2π] or NaN, never +0.0), [`REJECTED`] first
+    /// if the screen rejects one of them.
+    to_vertex: Vec<[AtomicU64; 2]>,
+    /// `[i·n + e]`: the two angles at host vertex `i` towards the foot of its perpendicular
+    /// on host edge `e`, then the two at that foot towards vertex `i` (or [`REJECTED`]).
+    to_foot: Vec<[AtomicU64; 4]>,
+    /// The host as a piece, and its edge index (built when first needed).
+    piece: Piece,
+    index: std::sync::OnceLock<unamalla_mesh::SegmentIndex>,
+    /// `[i·n + j]`, `[i·n + e]`: whether the cut from host vertex `i` to vertex `j`, or to
+    /// the foot of its perpendicular on edge `e`, is admissible in the host: 0 not known
+    /// yet, 1 no, 2 yes.
+    admits_vertex: Vec<AtomicU8>,
+    admits_foot: Vec<AtomicU8>,
+}
+
+/// The bits an [`CutTable`] entry starts with when the screen rejects it: those of −1, never
+/// an angle.
+const REJECTED: u64 = 0xbff0_0000_0000_0000;
+
+/// Where the vertices and edges of a ring are those of an [`CutTable`] host: host vertex
+/// of each ring vertex with the same point and neighbours, host edge of each ring edge with
+/// the same end points (`usize::MAX`: none).
+struct HostMatch {
+    vertex: Vec<usize>,
+    edge: Vec<usize>,
+}
+
+impl<'a> CutTable<'a> {
+    /// An empty table of `host`'s angles, screened by `screen` (tier 1's).
+    fn new(host: &'a [DVec2], screen: AngleScreen) -> Self {
+        let n2 = host.len() * host.len();
+        Self {
+            host,
+            screen,
+            to_vertex: (0..n2).map(|_| Default::default()).collect(),
+            to_foot: (0..n2).map(|_| Default::default()).collect(),
+            piece: Piece {
+                outer: Ring {
+                    pts: host.to_vec(),
+                    tags: vec![Tag::Boundary(0); host.len()],
+                },
+                holes: Vec::new(),
+            },
+            index: std::sync::OnceLock::new(),
+            admits_vertex: (0..n2).map(|_| AtomicU8::new(0)).collect(),
+            admits_foot: (0..n2).map(|_| AtomicU8::new(0)).collect(),
+        }
+    }
+
+    /// Whether the cut from host vertex `i` to `to` (a host vertex, or the foot of the
+    /// perpendicular from vertex `i` on a host edge) is admissible in the host
+    /// ([`Piece::admissible`], computed once).
+    ///
+    /// In a child of the host whose vertex there has the host's neighbours (and whose edge
+    /// holding a foot is the host's), the cut is admissible exactly when it is admissible in
+    /// the host and its open segment meets none of the child's edges that are not host edges
+    /// (the cut that made the child, or part of a host edge it split): the wedges at the ends
+    /// are the same; a segment inside the child is inside the host, meets no child edge and
+    /// so none of those; and a segment inside the host that meets no child edge outside the
+    /// host's stays on one side of the cut, the child's side at its ends.
+    fn admissible(&self, i: usize, to: End) -> bool {
+        let n = self.host.len();
+        let slot = match to.pos {
+            Pos::Vertex(j) => &self.admits_vertex[i * n + j],
+            Pos::OnEdge(e, _) => &self.admits_foot[i * n + e],
+        };
+        match slot.load(Ordering::Relaxed) {
+            1 => false,
+            2 => true,
+            _ => {
+                let idx = self.index.get_or_init(|| self.piece.index());
+                let from = End {
+                    ring: 0,
+                    pos: Pos::Vertex(i),
+                };
+                let a = self.piece.admissible(idx, from, to);
+                slot.store(if a { 2 } else { 1 }, Ordering::Relaxed);
+                a
+            }
+        }
+    }
+
+    /// The vertices and edges of `ring` that are the host's (see [`HostMatch`]).
+    fn locate(&self, ring: &Ring) -> HostMatch {
+        let (n, m) = (ring.len(), self.host.len());
+        let same =
+            |a: DVec2, b: DVec2| a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits();
+        // match from the host vertex of the ring's first point (or second, when the first
+        // is a point inserted by a cut)
+        let start = ring
+            .pts
+            .iter()
+            .take(2)
+            .find_map(|&p| self.host.iter().position(|&h| same(h, p)))
+            .unwrap_or(0);
+        let map = match_vertices(&ring.pts, self.host, start);
+        let vertex = (0..n)
+            .map(|k| {
+                let j = map[k];
+                let kept = j != usize::MAX
+                    && same(self.host[(j + m - 1) % m], ring.prev(k))
+                    && same(self.host[(j + 1) % m], ring.next(k));
+                if kept {
+                    j
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
+        let edge = (0..n)
+            .map(|k| {
+                let (j, l) = (map[k], map[(k + 1) % n]);
+                if j != usize::MAX && l == (j + 1) % m {
+                    j
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
+        HostMatch { vertex, edge }
+    }
+
+    /// Reads the angles stored at `slot`, or stores and returns those `compute` gives;
+    /// `None` if they are (or `compute` finds them) rejected by the screen.
+    fn cached<const K: usize>(
+        slot: &[AtomicU64; K],
+        compute: impl FnOnce() -> Option<[f64; K]>,
+    ) -> Option<[f64; K]> {
+        let bits = slot.each_ref().map(|a| a.load(Ordering::Relaxed));
+        if bits[0] == REJECTED {
+            return None;
+        }
+        if bits.iter().all(|&b| b != 0) {
+            return Some(bits.map(f64::from_bits));
+        }
+        // another thread may compute the same angles at the same time: the same values
+        let v = compute();
+        match v {
+            None => slot[0].store(REJECTED, Ordering::Relaxed),
+            Some(v) => {
+                for (a, x) in slot.iter().zip(v) {
+                    a.store(x.to_bits(), Ordering::Relaxed);
+                }
+            }
+        }
+        v
+    }
+
+    /// The angles at host vertex `i` towards host vertex `j`, `None` if the screen rejects
+    /// one.
+    fn vertex_angles(&self, i: usize, j: usize) -> Option<[f64; 2]> {
+        let h = self.host;
+        let n = h.len();
+        Self::cached(&self.to_vertex[i * n + j], || {
+            let (prev, p, next, q) = (h[(i + n - 1) % n], h[i], h[(i + 1) % n], h[j]);
+            let screened =
+                self.screen.surely_below(q, p, next) || self.screen.surely_below(prev, p, q);
+            (!screened).then(|| [left_angle(q, p, next), left_angle(prev, p, q)])
+        })
+    }
+
+    /// The angles at host vertex `i` towards `x`, the foot of its perpendicular on host edge
+    /// `e`, then at `x` towards vertex `i`; `None` if the screen rejects one.
+    fn foot_angles(&self, i: usize, e: usize, x: DVec2) -> Option<[f64; 4]> {
+        let h = self.host;
+        let n = h.len();
+        Self::cached(&self.to_foot[i * n + e], || {
+            let (prev, p, next) = (h[(i + n - 1) % n], h[i], h[(i + 1) % n]);
+            let (a, b) = (h[e], h[(e + 1) % n]);
+            let sc = &self.screen;
+            let screened = sc.surely_below(x, p, next)
+                || sc.surely_below(prev, p, x)
+                || sc.surely_below(p, x, b)
+                || sc.surely_below(a, x, p);
+            (!screened).then(|| {
+                [
+                    left_angle(x, p, next),
+                    left_angle(prev, p, x),
+                    left_angle(p, x, b),
+                    left_angle(a, x, p),
+                ]
+            })
+        })
     }
 }
 
@@ -512,7 +764,7 @@ impl Builder<'_> {
         !angles.iter().any(|&a| a < tol.theta_minus)
             && (ring.len() < 3 || angles.iter().copied().fold(0.0, f64::max) <= tol.theta_plus)
             && self.usable_with_angles(&ring.pts, angles)
-            && concavity_with_angles(&ring.pts, angles).approximately_convex(tol)
+            && measures_with_angles(&ring.pts, angles).approximately_convex(tol)
     }
 
     /// The corner score F of a good block ([`Builder::good`]); `None` if it is not good. The
@@ -546,13 +798,13 @@ impl Builder<'_> {
         } else {
             !crit.is_empty()
                 || !self.usable(&ring.pts)
-                || !concavity(&ring.pts).approximately_convex(tol)
+                || !measures(&ring.pts).approximately_convex(tol)
         }
     }
 
     /// The best cut splitting `ring` into two good blocks.
     fn best_split(&self, ring: &Ring) -> Option<Split> {
-        self.best_split_by(ring, &|r: &Ring| self.good_fit(r), true)
+        self.best_split_by(ring, &|r: &Ring| self.good_fit(r), true, None)
     }
 
     /// The best cut splitting `ring` into two blocks that `accept` takes; `accept` returns the
@@ -565,18 +817,20 @@ impl Builder<'_> {
     ///
     /// `good_only` says that `accept` takes only good blocks ([`Builder::good_fit`], possibly
     /// narrowed): then candidates whose children cannot both be good are not built
-    /// ([`Builder::for_each_split`]); it changes no result.
+    /// ([`Builder::for_each_split`]); it changes no result. `angles`: the [`CutTable`] of a
+    /// ring that `ring` is a child of (or `ring` itself), if the caller keeps one.
     fn best_split_by(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
+        angles: Option<&CutTable>,
     ) -> Option<Split> {
-        self.best_split_with(ring, accept, good_only, false)
+        self.best_split_with(ring, accept, good_only, false, angles)
             .or_else(|| {
                 self.opts
                     .edge_point_cuts
-                    .then(|| self.best_split_with(ring, accept, good_only, true))
+                    .then(|| self.best_split_with(ring, accept, good_only, true, angles))
                     .flatten()
             })
     }
@@ -588,6 +842,7 @@ impl Builder<'_> {
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
         quarter_points: bool,
+        angles: Option<&CutTable>,
     ) -> Option<Split> {
         let mut best: Option<Split> = None;
         let need = if good_only { 2 } else { 0 };
@@ -599,6 +854,7 @@ impl Builder<'_> {
             quarter_points,
             need,
             Some(&bound),
+            angles,
             &mut |pre, a, b, ends| {
                 // `accept` is pure: the second child is not looked at when the first fails
                 let Some(fa) = accept(&a) else { return };
@@ -627,13 +883,15 @@ impl Builder<'_> {
     /// With a `bound` (the caller's best two-child score so far, NaN while there is none),
     /// the search ends at the first candidate whose `pre` reaches it: the caller keeps a
     /// candidate only if it scores below the bound, which no candidate from there on can
-    /// (`beyond_best`).
+    /// (`beyond_best`). With `angles`, the new angles at the ends of a cut (without the
+    /// quarter points) come from that table where `ring`'s vertices and edges are its host's.
     fn for_each_split(
         &self,
         ring: &Ring,
         quarter_points: bool,
         need: usize,
         bound: Option<&Cell<f64>>,
+        angles: Option<&CutTable>,
         visit: &mut dyn FnMut(f64, Ring, Ring, (DVec2, DVec2)),
     ) {
         let n = ring.len();
@@ -651,10 +909,85 @@ impl Builder<'_> {
             outer: ring.clone(),
             holes: Vec::new(),
         };
-        let idx = piece.index();
+        // the ring's edge index, built if a cut is tested without the table
+        let idx_cell = std::cell::OnceCell::new();
+        let idx = || idx_cell.get_or_init(|| piece.index());
         let sq = piece.area().abs().sqrt().max(1e-300);
         let w = self.opts.cut_weights;
         let mut cands: Vec<(f64, End, End)> = Vec::new();
+        let table = angles
+            .filter(|_| !quarter_points)
+            .map(|t| (t, t.locate(ring)));
+        // the cut from vertex `i` to `e2` in the host's numbering, where the table has it:
+        // the host vertex of `i`, and the host vertex or the foot on a host edge of `e2`
+        let in_host = |i: usize, e2: End| {
+            let (t, at) = table.as_ref()?;
+            let hi = at.vertex[i];
+            if hi == usize::MAX {
+                return None;
+            }
+            let to = match e2.pos {
+                Pos::Vertex(j) if at.vertex[j] != usize::MAX => Pos::Vertex(at.vertex[j]),
+                Pos::OnEdge(e, x) if at.edge[e] != usize::MAX => Pos::OnEdge(at.edge[e], x),
+                _ => return None,
+            };
+            Some((*t, hi, End { ring: 0, pos: to }))
+        };
+        // the angle terms of the cut from vertex `i` (as `angle_terms` in tier 1), from the
+        // table where it has the angles
+        let terms = |i: usize, e2: End| {
+            let e1 = End {
+                ring: 0,
+                pos: Pos::Vertex(i),
+            };
+            // (a cut the screen rejects at either end gets `None`, as in `angle_terms`)
+            match in_host(i, e2) {
+                None => self.angle_terms(&piece, e1, e2, 1),
+                Some((
+                    t,
+                    hi,
+                    End {
+                        pos: Pos::Vertex(hj),
+                        ..
+                    },
+                )) => {
+                    let [a, b] = t.vertex_angles(hi, hj)?;
+                    let [c, d] = t.vertex_angles(hj, hi)?;
+                    self.angle_terms_of([a, b, c, d], 1)
+                }
+                Some((
+                    t,
+                    hi,
+                    End {
+                        pos: Pos::OnEdge(he, x),
+                        ..
+                    },
+                )) => self.angle_terms_of(t.foot_angles(hi, he, x)?, 1),
+            }
+        };
+        // the ring's edges that are not the host's (see `CutTable::admissible`)
+        let not_host: Vec<(DVec2, DVec2)> = table
+            .as_ref()
+            .map(|(_, at)| {
+                (0..n)
+                    .filter(|&k| at.edge[k] == usize::MAX)
+                    .map(|k| (ring.p(k), ring.next(k)))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let admissible = |e1: End, e2: End| {
+            let Pos::Vertex(i) = e1.pos else {
+                return piece.admissible(idx(), e1, e2);
+            };
+            match in_host(i, e2) {
+                Some((t, hi, to)) => {
+                    let (p, q) = (piece.point(e1), piece.point(e2));
+                    t.admissible(hi, to)
+                        && !not_host.iter().any(|&(a, b)| open_segment_hits(p, q, a, b))
+                }
+                None => piece.admissible(idx(), e1, e2),
+            }
+        };
         // the target list, reused for every start vertex
         let mut t = Vec::new();
         for i in 0..n {
@@ -688,7 +1021,7 @@ impl Builder<'_> {
                         continue; // each vertex pair once
                     }
                 }
-                let Some((pen, _)) = self.angle_terms(&piece, e1, e2, 1) else {
+                let Some((pen, _)) = terms(i, e2) else {
                     continue;
                 };
                 let q = piece.point(e2);
@@ -698,10 +1031,13 @@ impl Builder<'_> {
         // the candidates in the order of (pre, coordinates of both ends, position): the
         // sequence a stable sort by pre and coordinates gives, sorted only as far as the
         // search goes (`visit_sorted`)
-        let mut order: Vec<(f64, usize)> = (0..cands.len()).map(|k| (cands[k].0, k)).collect();
+        // (pre by its `total_cmp` key)
+        let mut order: Vec<(u64, usize)> = (0..cands.len())
+            .map(|k| (total_key(cands[k].0), k))
+            .collect();
         let mut evaluated = 0;
-        let cmp = |&(sa, ka): &(f64, usize), &(sb, kb): &(f64, usize)| {
-            sa.total_cmp(&sb)
+        let cmp = |&(sa, ka): &(u64, usize), &(sb, kb): &(u64, usize)| {
+            sa.cmp(&sb)
                 .then_with(|| {
                     let (a, b) = (&cands[ka], &cands[kb]);
                     let (pa, pb) = (piece.point(a.1), piece.point(b.1));
@@ -718,7 +1054,7 @@ impl Builder<'_> {
             if evaluated >= 80 || bound.is_some_and(|b| beyond_best(pre, b.get())) {
                 return false;
             }
-            if !piece.admissible(&idx, e1, e2) {
+            if !admissible(e1, e2) {
                 return true;
             }
             evaluated += 1;
@@ -728,10 +1064,8 @@ impl Builder<'_> {
             {
                 return true;
             }
-            let mut m = piece.clone();
-            let (x, y) = m.insert_ends(e1, e2);
-            let (a, b) = m.split(x, y, TMP_CUT);
-            visit(pre, a.outer, b.outer, (m.outer.p(x), m.outer.p(y)));
+            let (a, b, ends) = piece.split_between(e1, e2, TMP_CUT);
+            visit(pre, a.outer, b.outer, ends);
             true
         });
     }
@@ -743,11 +1077,15 @@ impl Builder<'_> {
     /// `½·max(F₁, F₂, F₃) + (F₁ + F₂ + F₃)/6 + pre₁ + pre₂` — the two-child score
     /// `½·max + ½·mean` with the mean over three, plus both cuts' angle and length terms.
     /// `good_only` as in [`Builder::best_split_by`].
+    ///
+    /// `angles` is the [`CutTable`] table of `ring`, shared by the search of the first cuts
+    /// and the searches of the second cuts in their children.
     fn best_split3(
         &self,
         ring: &Ring,
         accept: &(dyn Fn(&Ring) -> Option<f64> + Sync),
         good_only: bool,
+        angles: &CutTable,
     ) -> Option<Resplit> {
         let mut best: Option<Resplit> = None;
         for quarter_points in [false, true] {
@@ -764,6 +1102,7 @@ impl Builder<'_> {
                 quarter_points,
                 need,
                 None,
+                Some(angles),
                 &mut |pre1, a, b, ends1| {
                     firsts.push((pre1, a, b, ends1));
                 },
@@ -778,7 +1117,7 @@ impl Builder<'_> {
                         _ => return None,
                     };
                     let (s2, r1, r2, ends2) =
-                        self.best_split_by(&as_first_cut(rest), accept, good_only)?;
+                        self.best_split_by(&as_first_cut(rest), accept, good_only, Some(angles))?;
                     let (f1, f2) = (accept(&r1)?, accept(&r2)?);
                     let pre2 = s2 - 0.5 * f1.max(f2) - 0.25 * (f1 + f2);
                     let s = 0.5 * fk.max(f1).max(f2) + (fk + f1 + f2) / 6.0 + pre1 + pre2;
@@ -875,7 +1214,7 @@ impl Builder<'_> {
             .map(|(_, _, u)| match accept(u) {
                 Some(cost) => Some((cost, None)),
                 None => self
-                    .best_split_by(u, accept, good_only)
+                    .best_split_by(u, accept, good_only, None)
                     .map(|s| (s.0, Some(s))),
             })
             .collect();
@@ -981,14 +1320,32 @@ impl Builder<'_> {
             } else {
                 limit
             };
+            let is_two = matches!(host, Host::Merged2 { .. });
+            // the same host searched before (in an earlier sweep or layout): its candidates
+            // (exact, `host_key`)
+            let cache = self.cache.as_ref().map(|c| &c.repair);
+            let (key, ids) = host_key(u, limit, is_two);
+            let hit = cache.and_then(|c| c.lock().ok()?.hosts.get(&key).cloned());
+            if let Some(found) = hit.and_then(|f| relabel_resplits(&f, &|c| ids.get(c).copied())) {
+                return found;
+            }
             let good = |u: &Ring| memo.good_fit(self, u).filter(|&f| f <= limit);
-            let two = matches!(host, Host::Merged2 { .. })
-                .then(|| self.best_split_by(u, &good, true))
+            let angles = CutTable::new(&u.pts, *self.tier1_screen());
+            let two = is_two
+                .then(|| self.best_split_by(u, &good, true, Some(&angles)))
                 .flatten()
                 .map(|(s, a, b, ends)| (s, vec![as_first_cut(a), as_first_cut(b)], vec![ends]));
-            two.into_iter()
-                .chain(self.best_split3(u, &good, true))
-                .collect()
+            let found: Vec<Resplit> = two
+                .into_iter()
+                .chain(self.best_split3(u, &good, true, &angles))
+                .collect();
+            let canon = relabel_resplits(&found, &|c| ids.iter().position(|&x| x == c));
+            if let (Some(cache), Some(canon)) = (cache, canon) {
+                if let Ok(mut c) = cache.lock() {
+                    c.hosts.insert(key, canon);
+                }
+            }
+            found
         };
         // the lowest score wins, candidates compared in host order (as a sequential loop
         // over the hosts would: the searches are pure, the memo only saves work)
@@ -1009,18 +1366,16 @@ impl Builder<'_> {
             fold(&mut best, *host, f);
         }
         // the fewest blocks disturbed: two neighbours only when no re-split of the block
-        // alone or with one neighbour works, and only up to the first of those that works
-        // (searched a few at a time in parallel: a later one would be searched in vain)
-        for chunk in hosts2.chunks(rayon::current_num_threads().max(1)) {
-            if best.is_some() {
-                break;
-            }
-            let found: Vec<Vec<Resplit>> = chunk.par_iter().map(candidates).collect();
-            for ((host, _), f) in chunk.iter().zip(found) {
-                if best.is_some() {
-                    break;
-                }
-                fold(&mut best, *host, f);
+        // alone or with one neighbour works, and then the first of those that works (the
+        // sequential loop stops at the next one once it has a candidate; searched in
+        // parallel, the later ones are given up once an earlier one has candidates)
+        if best.is_none() {
+            let first = hosts2
+                .par_iter()
+                .map(|h| (h.0, candidates(h)))
+                .find_first(|(_, found)| !found.is_empty());
+            if let Some((host, found)) = first {
+                fold(&mut best, host, found);
             }
         }
         best
@@ -1082,7 +1437,7 @@ impl Builder<'_> {
         if triangle.is_none() && !self.usable(&ring.pts) {
             return None;
         }
-        let grade = if concavity(&ring.pts).approximately_convex(tol) {
+        let grade = if measures(&ring.pts).approximately_convex(tol) {
             1.0
         } else {
             3.0
@@ -1147,7 +1502,7 @@ impl Builder<'_> {
             }
             budget -= 1;
             let relaxed = |u: &Ring| self.relaxed_cost(u);
-            let alone = self.best_split_by(&r, &relaxed, false);
+            let alone = self.best_split_by(&r, &relaxed, false, None);
             let merge = self.best_merge(slot, k, alive, &relaxed, false);
             match (alone, merge) {
                 (Some(s), m) if m.as_ref().is_none_or(|m| s.0 <= m.0) => {
@@ -1474,6 +1829,126 @@ mod tests {
         for &(p, q) in &b.cuts {
             assert!((p.distance(q) - 1.0).abs() < 1e-12, "{p:?}–{q:?}");
         }
+    }
+
+    /// Where `CutTable::locate` matches a child's vertices and edges to the host's, the
+    /// table's angles are `Builder::end_angles` on the child, bit for bit, and a cut between
+    /// two such vertices is admissible in the child exactly when the table has it admissible
+    /// in the host and it meets none of the child's other edges.
+    #[test]
+    fn end_angle_table_matches_the_child_angles() {
+        let mut state = 0x5eed_1234_abcd_0001u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let bits = |a: [f64; 2]| a.map(f64::to_bits);
+        let (mut checked, mut admitted) = (0, 0);
+        for _ in 0..200 {
+            let n = 6 + (next() * 30.0) as usize;
+            let pts: Vec<DVec2> = (0..n)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * (i as f64 + 0.5 * next()) / n as f64;
+                    let r = 0.5 + next();
+                    v(r * t.cos(), r * t.sin())
+                })
+                .collect();
+            let host = ring(
+                &pts.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>(),
+                &vec![B; n],
+            );
+            let opts = DecomposeOptions::default();
+            let region = l_region();
+            let builder = Builder::new(&region, &opts);
+            let table = CutTable::new(&host.pts, *builder.tier1_screen());
+            // a child: the host from vertex i on, closed by a cut to a point inside an edge
+            let i = (next() * n as f64) as usize % n;
+            let len = 3 + (next() * (n - 4) as f64) as usize;
+            let mut child: Vec<DVec2> = (0..len).map(|k| host.pts[(i + k) % n]).collect();
+            let (a, b) = (host.pts[(i + len - 1) % n], host.pts[(i + len) % n]);
+            let x = a + 0.5 * (b - a);
+            child.push(x);
+            // a child of an admissible cut lies in the host (admissibility is compared there)
+            let host_piece = Piece {
+                outer: host.clone(),
+                holes: Vec::new(),
+            };
+            let cut_ends = [
+                End {
+                    ring: 0,
+                    pos: Pos::OnEdge((i + len - 1) % n, x),
+                },
+                End {
+                    ring: 0,
+                    pos: Pos::Vertex(i),
+                },
+            ];
+            let inside = host_piece.admissible_scan(cut_ends[0], cut_ends[1]);
+            let child = Ring {
+                tags: vec![B; child.len()],
+                pts: child,
+            };
+            let at = table.locate(&child);
+            let piece = Piece {
+                outer: child.clone(),
+                holes: Vec::new(),
+            };
+            let m = child.len();
+            for k in (0..m).filter(|&k| at.vertex[k] != usize::MAX) {
+                let e1 = End {
+                    ring: 0,
+                    pos: Pos::Vertex(k),
+                };
+                for l in (0..m).filter(|&l| l != k && at.vertex[l] != usize::MAX) {
+                    let q = child.pts[l];
+                    let (x, y) = Builder::end_angles(&piece, e1, q);
+                    // the screen rejects only angles below θ₋
+                    match table.vertex_angles(at.vertex[k], at.vertex[l]) {
+                        Some(got) => assert_eq!(bits(got), bits([x, y])),
+                        None => assert!(x.min(y) < opts.tolerances.theta_minus),
+                    }
+                    checked += 1;
+                    // admissibility from the host's and the child's other edges
+                    let idx = piece.index();
+                    let e2 = End {
+                        ring: 0,
+                        pos: Pos::Vertex(l),
+                    };
+                    let to = End {
+                        ring: 0,
+                        pos: Pos::Vertex(at.vertex[l]),
+                    };
+                    let p = child.pts[k];
+                    let hits = (0..m)
+                        .filter(|&f| at.edge[f] == usize::MAX)
+                        .any(|f| open_segment_hits(p, q, child.p(f), child.next(f)));
+                    if inside {
+                        let via_host = table.admissible(at.vertex[k], to) && !hits;
+                        assert_eq!(piece.admissible(&idx, e1, e2), via_host, "{k} {l}");
+                        admitted += via_host as usize;
+                    }
+                }
+                for e in (0..m).filter(|&e| at.edge[e] != usize::MAX) {
+                    let (a, b) = (child.p(e), child.next(e));
+                    let x = a + crate::geom::project_t(child.pts[k], a, b) * (b - a);
+                    let (p0, p1) = Builder::end_angles(&piece, e1, x);
+                    let e2 = End {
+                        ring: 0,
+                        pos: Pos::OnEdge(e, x),
+                    };
+                    let (f0, f1) = Builder::end_angles(&piece, e2, child.pts[k]);
+                    let want = [p0, p1, f0, f1];
+                    match table.foot_angles(at.vertex[k], at.edge[e], x) {
+                        Some(got) => assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits)),
+                        None => assert!(want.iter().any(|&a| a < opts.tolerances.theta_minus)),
+                    }
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked}");
+        assert!(admitted > 100, "{admitted}");
     }
 
     #[test]
