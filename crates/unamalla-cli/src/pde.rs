@@ -42,8 +42,10 @@ pub struct PdeArgs {
     /// Example: `1=parabolic:1,3=const:0.5`.
     #[arg(long, default_value = "all=const:0", allow_hyphen_values = true)]
     pub bc: String,
-    /// Verify with a manufactured solution instead of --g/--bc: `sin-cosh` (U = sin(πx)cosh(y))
-    /// or `poly` (a cubic); g = L U, U on the boundary; the error is printed.
+    /// Verify with a manufactured solution instead of --g/--bc: `sin-cosh` (U = sin(πx̂)cosh(ŷ))
+    /// or `poly` (a cubic) in the coordinates x̂ = (x − x_min)/L, ŷ = (y − y_min)/L of the mesh's
+    /// bounding box (L its larger side), so any map unit works; g = L U, U on the boundary; the
+    /// error is printed, also relative to max |U|.
     #[arg(long)]
     pub manufactured: Option<String>,
     /// Linear solver: `sor` (automatic ω) or `direct` (sparse LU).
@@ -215,10 +217,26 @@ pub fn run(a: PdeArgs) -> Result<()> {
         tol: a.tol,
         max_iterations: a.max_iter,
     };
+    let nodes: Vec<_> = match &mesh {
+        InputMesh::Grid(g) => unamalla_core::mesh::HasNodes::nodes(g).to_vec(),
+        InputMesh::Quads(q) => unamalla_core::mesh::HasNodes::nodes(q).to_vec(),
+    };
     let man = match &a.manufactured {
-        Some(name) => Some(Manufactured::by_name(name).with_context(|| {
-            format!("--manufactured: unknown solution '{name}' (sin-cosh, poly)")
-        })?),
+        // in the mesh's bounding box mapped into the unit square, so a map in kilometres
+        // does not overflow cosh
+        Some(name) => Some(
+            Manufactured::by_name(name)
+                .with_context(|| {
+                    format!("--manufactured: unknown solution '{name}' (sin-cosh, poly)")
+                })?
+                .on_box(&nodes)
+                .with_context(|| {
+                    format!(
+                        "--manufactured: {} has a bounding box of zero or non-finite size",
+                        a.mesh.display()
+                    )
+                })?,
+        ),
         None => None,
     };
     let eq = match &man {
@@ -230,11 +248,8 @@ pub fn run(a: PdeArgs) -> Result<()> {
         None => parse_bc(&a.bc)?,
     };
     check_overflow(&a)?;
-    let (sol, nodes): (Solution, Vec<_>) = match &mesh {
-        InputMesh::Grid(g) => (
-            solve_grid(g, &eq, &sides, &opts)?,
-            unamalla_core::mesh::HasNodes::nodes(g).to_vec(),
-        ),
+    let sol: Solution = match &mesh {
+        InputMesh::Grid(g) => solve_grid(g, &eq, &sides, &opts)?,
         InputMesh::Quads(q) => {
             let bc = match &man {
                 Some(m) => m.boundary(),
@@ -249,10 +264,7 @@ pub fn run(a: PdeArgs) -> Result<()> {
                     sides[0].clone()
                 }
             };
-            (
-                solve_quads(q, &eq, &bc, &opts)?,
-                unamalla_core::mesh::HasNodes::nodes(q).to_vec(),
-            )
+            solve_quads(q, &eq, &bc, &opts)?
         }
     };
 
@@ -325,6 +337,11 @@ pub fn run(a: PdeArgs) -> Result<()> {
             "u_max": umax,
             "error_max": err.map(|e| e.max),
             "error_rms": err.map(|e| e.rms),
+            "error_max_relative": err.map(|e| e.max / e.exact_max),
+            "manufactured_frame": man.map(|m| {
+                let (o, l) = m.frame();
+                serde_json::json!({ "origin": [o.x, o.y], "scale": l })
+            }),
             "seconds": sol.seconds,
         });
         println!("{v}");
@@ -341,9 +358,16 @@ pub fn run(a: PdeArgs) -> Result<()> {
             sol.residual, sol.seconds
         );
         if let (Some(e), Some(m)) = (err, &man) {
+            let (o, l) = m.frame();
             println!(
-                "manufactured {}: max error {:.3e}, rms error {:.3e}",
-                m.name, e.max, e.rms
+                "manufactured {} on (x − {:.6}, y − {:.6})/{:.6}: max error {:.3e} ({:.3e} of max|U|), rms error {:.3e}",
+                m.name,
+                o.x,
+                o.y,
+                l,
+                e.max,
+                e.max / e.exact_max,
+                e.rms
             );
         }
         eprintln!("wrote {}", a.output.display());
