@@ -403,7 +403,7 @@ fn mesh_part(
     // dropping holes changes the domain: said on stderr even with --quiet
     if !result.report.holes_dropped.is_empty() && a.min_hole_area.is_none() {
         eprintln!(
-            "warning: {name}: {} hole(s) narrower than the cell size were dropped (report.json \"holes_dropped\"); --keep-narrow-holes fails instead, a smaller --cell-size keeps them",
+            "warning: {name}: {} hole(s) narrower than the cell size (or than two, next to which the mesh failed) were dropped (report.json \"holes_dropped\", the notes say why); --keep-narrow-holes fails instead, a smaller --cell-size keeps them",
             result.report.holes_dropped.len()
         );
     }

@@ -192,20 +192,11 @@ fn hole_width(hole: &unamalla_mesh::Polygon) -> (f64, DVec2) {
     (unamalla_contour::hole_width(hole), 0.5 * (lo + hi))
 }
 
-/// The hole next to which the failing cells of `v` lie when it is narrower than the cell size
-/// `h` (the hole with the most listed failing cells within `h`; ties: the lowest index), or
-/// `None`. A listed cell is within `h` of a hole when one of its corners is (a cell outside:
-/// its centroid). Each listed cell (at most [`crate::verify::LISTED_CELLS`] per kind) is
-/// compared with every edge of every hole: the work is linear in the holes' vertices.
-pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> Option<SmallHole> {
-    if h.is_nan() || h <= 0.0 || region.holes().is_empty() {
-        return None;
-    }
-    // each listed cell by its points: the corners of a non-convex cell (a folded cell can be
-    // long: its centroid may lie several cells from the hole its corners touch), the centroid
-    // of a cell outside
-    let cells: Vec<Vec<DVec2>> = v
-        .non_convex_at
+/// The points of each cell a verification lists: the corners of a non-convex cell (a folded
+/// cell can be long: its centroid may lie several cells from the hole its corners touch), the
+/// centroid of a cell outside.
+fn failing_cell_points(v: &crate::verify::Verification) -> Vec<Vec<DVec2>> {
+    v.non_convex_at
         .iter()
         .map(|c| c.iter().map(|p| DVec2::new(p[0], p[1])).collect())
         .chain(
@@ -213,11 +204,14 @@ pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> O
                 .iter()
                 .map(|(_, p)| vec![DVec2::new(p[0], p[1])]),
         )
-        .collect();
-    let widths: Vec<(f64, DVec2)> = region.holes().iter().map(hole_width).collect();
-    let narrow: Vec<bool> = widths.iter().map(|w| w.0 < h).collect();
+        .collect()
+}
+
+/// For each hole of `region`, how many of the failing `cells` (given by their points) have
+/// it as their nearest hole at a distance of at most `h` (ties to the lower index).
+fn failures_next_to_holes(cells: &[Vec<DVec2>], region: &Region, h: f64) -> Vec<usize> {
     let mut count = vec![0usize; region.holes().len()];
-    for pts in &cells {
+    for pts in cells {
         let nearest = region
             .holes()
             .iter()
@@ -235,9 +229,52 @@ pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> O
             })
             .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
         if let Some((k, d)) = nearest {
-            if d <= h && narrow[k] {
+            if d <= h {
                 count[k] += 1;
             }
+        }
+    }
+    count
+}
+
+/// The holes of `region` narrower than `max_width` (the [`hole_width`] of the narrow-hole
+/// retry) that are the nearest hole, within `h`, of a cell the verification `v` lists as
+/// failing; in increasing order. What the later rounds of the narrow-hole retry of
+/// [`crate::Mesher::mesh_observed`] leave out.
+pub fn holes_next_to_failures(
+    v: &crate::verify::Verification,
+    region: &Region,
+    h: f64,
+    max_width: f64,
+) -> Vec<usize> {
+    if h.is_nan() || h <= 0.0 || region.holes().is_empty() {
+        return Vec::new();
+    }
+    let count = failures_next_to_holes(&failing_cell_points(v), region, h);
+    count
+        .iter()
+        .enumerate()
+        .filter(|&(k, &c)| c > 0 && hole_width(&region.holes()[k]).0 < max_width)
+        .map(|(k, _)| k)
+        .collect()
+}
+
+/// The hole next to which the failing cells of `v` lie when it is narrower than the cell size
+/// `h` (the hole with the most listed failing cells within `h`; ties: the lowest index), or
+/// `None`. A listed cell is within `h` of a hole when one of its corners is (a cell outside:
+/// its centroid). Each listed cell (at most [`crate::verify::LISTED_CELLS`] per kind) is
+/// compared with every edge of every hole: the work is linear in the holes' vertices.
+pub fn small_hole(v: &crate::verify::Verification, region: &Region, h: f64) -> Option<SmallHole> {
+    if h.is_nan() || h <= 0.0 || region.holes().is_empty() {
+        return None;
+    }
+    let cells = failing_cell_points(v);
+    let widths: Vec<(f64, DVec2)> = region.holes().iter().map(hole_width).collect();
+    let narrow: Vec<bool> = widths.iter().map(|w| w.0 < h).collect();
+    let mut count = failures_next_to_holes(&cells, region, h);
+    for (c, &n) in count.iter_mut().zip(&narrow) {
+        if !n {
+            *c = 0;
         }
     }
     let (hole, &cells) = count
@@ -619,6 +656,34 @@ mod tests {
             ..v
         };
         assert!(small_hole(&far, &r, 0.63).is_none());
+    }
+
+    /// The later rounds of the narrow-hole retry: the holes narrower than `max_width` that
+    /// are the nearest hole, within h, of a failing cell. Hole widths 0.4 (A), 0.3 (B), 2.0
+    /// (C); two failing cells beside A, one 0.2 from C. At h = 0.63 (max width 1.26) only A;
+    /// at h = 1.1 (max width 2.2) A and C; B has no failing cell; none for cells far away.
+    #[test]
+    fn holes_next_to_failures_are_the_narrow_nearest_ones() {
+        let r = three_holes();
+        let cell = |x: f64, y: f64| [[x, y], [x + 0.1, y], [x + 0.1, y + 0.1], [x, y + 0.1]];
+        let v = crate::verify::Verification {
+            non_convex_cells: 3,
+            non_convex_at: vec![cell(5.5, 5.0), cell(5.0, 4.6), cell(8.2, 2.0)],
+            ..Default::default()
+        };
+        assert_eq!(holes_next_to_failures(&v, &r, 0.63, 2.0 * 0.63), vec![0]);
+        assert_eq!(holes_next_to_failures(&v, &r, 1.1, 2.0 * 1.1), vec![0, 2]);
+        // a cell outside counts by its centroid, as a non-convex one by its corners
+        let outside = crate::verify::Verification {
+            outside_examples: vec![(7, [8.1, 2.0])],
+            ..Default::default()
+        };
+        assert_eq!(holes_next_to_failures(&outside, &r, 1.1, 2.2), vec![2]);
+        let far = crate::verify::Verification {
+            non_convex_at: vec![cell(9.5, 9.5)],
+            ..Default::default()
+        };
+        assert!(holes_next_to_failures(&far, &r, 1.1, 2.2).is_empty());
     }
 
     #[test]

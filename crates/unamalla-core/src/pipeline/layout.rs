@@ -17,6 +17,20 @@ pub const QUALITY_TARGET_PERCENT: f64 = 90.0;
 /// is bounded by `1 + LAYOUT_FALLBACKS + QUALITY_FALLBACKS` runs of the pipeline.
 pub const QUALITY_FALLBACKS: usize = 2;
 
+/// Further runs of the narrow-hole retry of [`Mesher::mesh_observed`] after the one without
+/// the holes narrower than a cell: each also leaves out the holes narrower than
+/// [`NEAR_HOLE_WIDTH`] cell sizes within a cell size of a failing cell. Each round is a run
+/// with its layout fallbacks, so the retry is bounded by
+/// `(1 + NEAR_HOLE_ROUNDS)·(1 + LAYOUT_FALLBACKS)` runs.
+pub const NEAR_HOLE_ROUNDS: usize = 2;
+
+/// The width, in cell sizes, below which a hole next to a failing cell may be left out by
+/// the later rounds of the narrow-hole retry ([`NEAR_HOLE_ROUNDS`]): an island less than two
+/// cells across has at most one row of cells along each side of its blocks, the case the
+/// untangling could not open (measured on the synthetic archipelago of 500 islands at 20,000
+/// cells, docs/results.md).
+pub const NEAR_HOLE_WIDTH: f64 = 2.0;
+
 /// Margin (share of cells) by which the chord layout's prediction must beat the concavity
 /// layout's to be chosen: the prediction is made on a coarse mesh with a few Laplacian sweeps,
 /// so differences below a percent are not resolved by it (`tests/predictor.rs`).

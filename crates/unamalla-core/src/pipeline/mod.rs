@@ -205,6 +205,10 @@ pub struct Mesher {
     shape: Option<ShapeOptions>,
     quality_target: f64,
     drop_narrow_holes: bool,
+    /// Holes (indices into the input region) left out before the simplification: set by the
+    /// narrow-hole retry of [`Mesher::mesh_observed`] for the holes near the cell scale next to
+    /// which a retry still failed.
+    dropped_near_failure: Vec<usize>,
     /// Candidate layouts [`choose_layout`] must not pick (set by the fallback of
     /// [`Mesher::mesh_observed`] after a layout failed the guarantee).
     excluded_layouts: Vec<String>,
@@ -240,6 +244,7 @@ impl std::fmt::Debug for Mesher {
             .field("shape", &self.shape)
             .field("quality_target", &self.quality_target)
             .field("drop_narrow_holes", &self.drop_narrow_holes)
+            .field("dropped_near_failure", &self.dropped_near_failure)
             .field("excluded_layouts", &self.excluded_layouts)
             .field("progress", &self.progress.as_ref().map(|_| "callback"))
             .finish()
@@ -286,6 +291,7 @@ impl Mesher {
             shape: Some(ShapeOptions::default()),
             quality_target: QUALITY_TARGET_PERCENT,
             drop_narrow_holes: true,
+            dropped_near_failure: Vec::new(),
             excluded_layouts: Vec::new(),
         }
     }
@@ -342,8 +348,11 @@ impl Mesher {
     /// retry runs only when the hole filter of the simplification is [`HoleFilter::KeepAll`]
     /// (a filter the user set is kept as it is) and the failure lies next to such a hole
     /// ([`crate::preflight::small_hole`]); it uses [`HoleFilter::MinWidth`]`(h)`, the dropped
-    /// holes are listed in [`MeshReport::holes_dropped`] and the report's notes say why. With
-    /// `false` the run fails with the error naming the hole and the remedies (a smaller cell
+    /// holes are listed in [`MeshReport::holes_dropped`] and the report's notes say why. If
+    /// that mesh fails too, at most [`NEAR_HOLE_ROUNDS`] more runs each also leave out the
+    /// holes narrower than `NEAR_HOLE_WIDTH · h` that lie within `h` of a failing cell (an
+    /// island one or two cells across gets blocks too thin to untangle, as one narrower than a
+    /// cell does; the others stay). With `false` the run fails with the error naming the hole and the remedies (a smaller cell
     /// size keeps the holes).
     pub fn drop_narrow_holes(mut self, yes: bool) -> Self {
         self.drop_narrow_holes = yes;

@@ -33,13 +33,33 @@ impl Mesher {
     /// ([`Mesher::feature_factor`]). The mesher meshes [`PreparedRegion::mesh_region`]; a
     /// decomposition file must have been made for it or for [`PreparedRegion::simplified`].
     pub fn prepare_region(&self, region: &Region) -> Result<PreparedRegion, CoreError> {
+        // the holes the narrow-hole retry leaves out (indices into `region`), then the
+        // simplification's own hole filter on the rest (its indices mapped back)
+        let reduced;
+        let (input, kept): (&Region, Vec<usize>) = if self.dropped_near_failure.is_empty() {
+            (region, (0..region.holes().len()).collect())
+        } else {
+            let kept: Vec<usize> = (0..region.holes().len())
+                .filter(|k| self.dropped_near_failure.binary_search(k).is_err())
+                .collect();
+            reduced = Region::new(
+                region.outer().points().to_vec(),
+                kept.iter()
+                    .map(|&k| region.holes()[k].points().to_vec())
+                    .collect(),
+            )?;
+            (&reduced, kept)
+        };
         let (simplified, holes_dropped) = match &self.simplify {
             Some(opts) => {
-                let r = simplify_for_mesh(region, opts)?;
-                let dropped = r.dropped_holes.iter().map(|h| h.hole).collect();
+                let r = simplify_for_mesh(input, opts)?;
+                let mut dropped: Vec<usize> =
+                    r.dropped_holes.iter().map(|h| kept[h.hole]).collect();
+                dropped.extend_from_slice(&self.dropped_near_failure);
+                dropped.sort_unstable();
                 (r.region, dropped)
             }
-            None => (region.clone(), Vec::new()),
+            None => (input.clone(), self.dropped_near_failure.clone()),
         };
         let h = match self.size {
             MeshSize::Cells(n) => Some((simplified.area() / n.max(1) as f64).sqrt()),
@@ -171,10 +191,16 @@ impl Mesher {
                     o.holes = HoleFilter::MinWidth(h);
                 }
                 self.excluded_layouts.clear();
-                if let Ok(retry) = self.mesh_unverified(region, observer) {
+                let mut notes = vec![note];
+                // round 0 without the holes narrower than a cell; each later round (at most
+                // NEAR_HOLE_ROUNDS) also without the holes narrower than NEAR_HOLE_WIDTH · h
+                // next to which the previous round failed
+                for round in 0..=NEAR_HOLE_ROUNDS {
+                    let Ok(retry) = self.mesh_unverified(region, observer) else {
+                        break;
+                    };
                     let rv = verify(&retry);
                     // the layout fallback once more, on the region without those holes
-                    let mut notes = vec![note];
                     let ((retry, rv), rv_last) =
                         self.layout_fallback(region, observer, &verify, (retry, rv), &mut notes);
                     if rv.passed() {
@@ -182,7 +208,33 @@ impl Mesher {
                         result = retry;
                         v = rv;
                         last = rv_last;
+                        break;
                     }
+                    if round == NEAR_HOLE_ROUNDS {
+                        break;
+                    }
+                    // the failing cells of the kept attempt, against the input's holes
+                    let near: Vec<usize> =
+                        preflight::holes_next_to_failures(&rv, region, h, NEAR_HOLE_WIDTH * h)
+                            .into_iter()
+                            .filter(|k| {
+                                self.dropped_near_failure.binary_search(k).is_err()
+                                    && unamalla_contour::hole_width(&region.holes()[*k]) >= h
+                            })
+                            .collect();
+                    if near.is_empty() {
+                        break;
+                    }
+                    let note = format!(
+                        "the mesh without the holes narrower than a cell failed the guarantee next to {} hole(s) narrower than {NEAR_HOLE_WIDTH} cell sizes ({}); made again without them too",
+                        near.len(),
+                        near.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(", ")
+                    );
+                    self.stage(Stage::Decompose, &note);
+                    notes.push(note);
+                    self.dropped_near_failure.extend(near);
+                    self.dropped_near_failure.sort_unstable();
+                    self.excluded_layouts.clear();
                 }
             }
         }
