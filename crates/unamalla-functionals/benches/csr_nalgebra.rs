@@ -3,7 +3,7 @@
 //! `(cells + 1)²` grid of the unit square with interior nodes moved by up to 0.15 h
 //! (deterministic), 100² and 300² cells:
 //!
-//! * `refresh/ours`: `Problem::hessian`, the values refreshed in place (parallel);
+//! * `refresh/ours`: `Hessian::hessian`, the values refreshed in place (parallel);
 //! * `refresh/ours+copy-into-nalgebra`: the same, then [`Csr::copy_values_into`] an existing
 //!   `CsrMatrix` of the same pattern (how a nalgebra-sparse user keeps one up to date);
 //! * `refresh/ours+convert-to-nalgebra`: the same, then a fresh [`Csr::to_nalgebra_sparse`];

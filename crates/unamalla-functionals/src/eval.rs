@@ -36,7 +36,7 @@ use crate::kernel::{
     Area, AreaOrthogonality, CastilloArea, HOmega, KArea, KSmoothness, KernelExpr, Length,
     Orthogonality, RegularizedInverseArea, RegularizedSmoothness, Smoothness, A4P,
 };
-use crate::problem::Problem;
+use crate::problem::{Gradient, Variables};
 use crate::quad::{QuadFunctional, QuadTopology};
 
 /// Names accepted by [`FunctionalSpec::from_name`].

@@ -33,12 +33,13 @@
 //! With the stencil column `w_j = (w_0j, w_1j, w_2j)` of vertex `j`, `α_j = Σ_a w_aj c_a`,
 //! `β_j = Σ_a w_aj ∂V/∂c_a` and `G_jl = w_j·w_l`, the chain rule
 //! `H_jl = Σ_ab w_aj w_bl ∂²f/∂c_a∂c_b` collapses (using `Σ_ab w_aj w_bl ε_abc = (w_j × w_l)_c`) to
-//! `H_jl = wt·[φ(r G_jl I + α_j α_lᵀ/(3r)) + φ'r(α_j β_lᵀ + β_j α_lᵀ) + λφ''β_j β_lᵀ
-//! + λφ'M(Σ_c (w_j × w_l)_c c_c)]`: ten closed-form 3×3 blocks per tetrahedron (the other six
+//! `H_jl = wt·[φ(r G_jl I + α_j α_lᵀ/(3r)) + φ'r(α_j β_lᵀ + β_j α_lᵀ) + λφ''β_j β_lᵀ +
+//! λφ'M(Σ_c (w_j × w_l)_c c_c)]`: ten closed-form 3×3 blocks per tetrahedron (the other six
 //! by symmetry) instead of spreading the 9 column blocks over up to 16 vertex pairs. The
 //! blocks of a cell are summed as 8×8 node blocks and added at CSR positions computed once
 //! with the pattern ([`HexTopology::block_slots`]). The face terms use the same form (legs
-//! `B−A, D−A, C−A`). The previous assembly is kept as [`HexFunctional::hessian_reference`].
+//! `B−A, D−A, C−A`). The previous per-tetrahedron assembly is kept (private) as the
+//! fallback for meshes too large for the slot table and as the tests' reference.
 //!
 //! # Coplanarity ([Cortés Aguirre 2012, §4.1] criterion 2, (4.2)–(4.4))
 //! For a face `ABCD`: `N = AB × AD`, `k = N·AC/(‖N‖‖AC‖)` (a signed cosine; `k² = |cos|²`). The
@@ -61,7 +62,11 @@ use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
 use crate::csr::Csr;
 use crate::error::FunctionalError;
 use crate::kernel::phi_omega;
-use crate::problem::{LocalModel, Problem};
+#[cfg(doc)]
+use crate::problem::Problem;
+use crate::problem::{
+    Cost, ElementMeasures, Gradient, Hessian, LocalModel, PointwiseModel, Variables,
+};
 
 /// The six faces of a hexahedron (0-based VTK indices), in 1-based vertex numbers
 /// (1234), (5678), (1265), (4378), (1485), (2376) — the same table the quality module's
@@ -1029,13 +1034,13 @@ impl HexFunctional {
 
     /// The Hessian by the original per-tetrahedron assembly: each term's column Hessian is
     /// spread over a 24×24 cell matrix (`scatter_hess3`), whose entries are then located in the
-    /// CSR rows by binary search. Kept as the reference the node-block
-    /// [`Problem::hessian`] is tested against (same values up to rounding) and as the
-    /// benchmark baseline; `h` must come from [`Problem::hessian_pattern`].
+    /// CSR rows by binary search. The fallback of the node-block [`Hessian::hessian`] when its
+    /// slot table cannot be built, and the reference the tests check it against (same values up
+    /// to rounding); `h` must come from [`Hessian::hessian_pattern`].
     ///
     /// # Panics
     /// If `x` or `h` do not fit the mesh.
-    pub fn hessian_reference(&self, x: &[f64], h: &mut Csr) {
+    fn hessian_scatter(&self, x: &[f64], h: &mut Csr) {
         assert_eq!(x.len(), self.num_vars(), "hessian: x has the wrong length");
         assert!(
             self.topo.asm.matches_pattern(3, h),
@@ -1104,7 +1109,7 @@ fn check_finite(name: &'static str, v: f64) -> Result<f64, FunctionalError> {
     }
 }
 
-impl Problem for HexFunctional {
+impl Variables for HexFunctional {
     fn dim(&self) -> usize {
         3
     }
@@ -1117,7 +1122,9 @@ impl Problem for HexFunctional {
     fn var_of(&self, node: usize) -> Option<usize> {
         self.topo.var_of(node)
     }
+}
 
+impl Cost for HexFunctional {
     fn value(&self, x: &[f64]) -> f64 {
         assert_eq!(x.len(), self.num_vars(), "value: x has the wrong length");
         self.topo.asm.run_value(|c| {
@@ -1126,7 +1133,9 @@ impl Problem for HexFunctional {
             self.cell_eval(c, &p, None, &mut g, None)
         })
     }
+}
 
+impl Gradient for HexFunctional {
     fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
         assert_eq!(
             x.len(),
@@ -1158,7 +1167,9 @@ impl Problem for HexFunctional {
             v
         })
     }
+}
 
+impl Hessian for HexFunctional {
     fn hessian_pattern(&self) -> Csr {
         self.topo.hessian_pattern()
     }
@@ -1167,8 +1178,8 @@ impl Problem for HexFunctional {
     /// as 8×8 closed-form 3×3 blocks (`tet_term_blocks`, `face_term_blocks`, see the module docs) and added at
     /// the CSR positions precomputed once with the pattern ([`HexTopology::block_slots`]).
     /// Cells run in the deterministic chunk colouring of `assembly` (bit-identical for any
-    /// thread count). Falls back to [`HexFunctional::hessian_reference`] when the slot table
-    /// cannot be built (more than `u32::MAX` entries).
+    /// thread count). Falls back to the per-tetrahedron scatter assembly (private) when the
+    /// slot table cannot be built (more than `u32::MAX` entries).
     fn hessian(&self, x: &[f64], h: &mut Csr) {
         assert_eq!(x.len(), self.num_vars(), "hessian: x has the wrong length");
         assert_eq!(
@@ -1181,7 +1192,7 @@ impl Problem for HexFunctional {
             "hessian: matrix does not come from hessian_pattern"
         );
         let Some(slots) = self.topo.block_slots() else {
-            self.hessian_reference(x, h);
+            self.hessian_scatter(x, h);
             return;
         };
         let values = &mut h.values;
@@ -1263,7 +1274,9 @@ impl Problem for HexFunctional {
             0.0
         });
     }
+}
 
+impl PointwiseModel for HexFunctional {
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         self.topo.var_of(node)?;
         assert_eq!(x.len(), self.num_vars(), "local: x has the wrong length");
@@ -1291,7 +1304,9 @@ impl Problem for HexFunctional {
         }
         Some(m)
     }
+}
 
+impl ElementMeasures for HexFunctional {
     fn num_elements(&self) -> usize {
         10 * self.topo.num_cells()
     }
@@ -1520,7 +1535,7 @@ mod tests {
                 let mut h = f.hessian_pattern();
                 let mut r = f.hessian_pattern();
                 f.hessian(&x, &mut h);
-                f.hessian_reference(&x, &mut r);
+                f.hessian_scatter(&x, &mut r);
                 let scale = r.values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
                 assert!(scale > 0.0);
                 for (k, (a, b)) in h.values.iter().zip(&r.values).enumerate() {

@@ -154,14 +154,14 @@ pub trait TriKernel: Send + Sync {
     fn terms(&self) -> Terms {
         CORNERS
     }
-    /// Value only (hot path of [`Problem::value`](crate::Problem::value); defaults to
+    /// Value only (hot path of [`Cost::value`](crate::Cost::value); defaults to
     /// [`eval`](Self::eval) with [`Order::Value`]).
     #[inline(always)]
     fn value(&self, s: &TriScalars) -> f64 {
         self.eval(s, Order::Value).v
     }
     /// Value and first partials (hot path of
-    /// [`Problem::value_grad`](crate::Problem::value_grad); defaults to [`eval`](Self::eval)
+    /// [`Gradient::value_grad`](crate::Gradient::value_grad); defaults to [`eval`](Self::eval)
     /// with [`Order::Gradient`]). Combinators override it so that no second-derivative storage
     /// is touched.
     #[inline(always)]

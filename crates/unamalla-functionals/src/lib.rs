@@ -63,9 +63,16 @@
 //! ([Cortés Aguirre 2012, §4.1, (4.2)–(4.4)]).
 //!
 //! ## The optimization interface
-//! [`Problem`] (value, value + gradient, Hessian pattern and refresh, Hessian-vector product,
-//! local model, per-element convexity measures) is implemented by [`QuadFunctional`] and
-//! [`HexFunctional`]. Topologies ([`QuadTopology`], [`HexTopology`]) hold the free-variable map,
+//! Small capability traits in the manner of argmin's `CostFunction` / `Gradient` / `Hessian`
+//! ([`problem`]): [`Variables`] (the free-node variables), [`Cost`] (`F(x)`), [`Gradient`]
+//! (`F` and `∇F`), [`Hessian`] (sparse pattern and refresh, Hessian-vector product),
+//! [`PointwiseModel`] (`F` restricted to one node) and [`ElementMeasures`] (the per-element
+//! convexity measures of the safeguard). [`Problem`] is all six (blanket implementation); the
+//! solvers of `unamalla-optim` bound their code by the capabilities they use. [`QuadFunctional`]
+//! and [`HexFunctional`] implement every one; a wrapper that changes one capability implements
+//! that trait alone and is combined with the inner problem by [`WithHessian`] or
+//! [`WithMeasures`]. `use unamalla_functionals::prelude::*` brings the traits into scope.
+//! Topologies ([`QuadTopology`], [`HexTopology`]) hold the free-variable map,
 //! the fixed coordinates and the parallel schedule and are shared through `Arc`, so changing ω
 //! or k only swaps the kernel. Evaluation is parallel (rayon) and bit-for-bit deterministic for
 //! any number of threads (chunk colouring, see [`assembly`]); no allocation happens per
@@ -113,5 +120,8 @@ pub use kernel::{
 };
 #[cfg(feature = "nalgebra-sparse")]
 pub use nalgebra_sparse_conv::CsrConversionError;
-pub use problem::{LocalModel, Problem};
+pub use problem::{
+    prelude, Cost, ElementMeasures, Gradient, Hessian, LocalModel, PointwiseModel, Problem,
+    Variables, WithHessian, WithMeasures,
+};
 pub use quad::{AlphaSummary, QuadFunctional, QuadTopology};

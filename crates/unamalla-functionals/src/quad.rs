@@ -19,7 +19,7 @@
 //! This one exact path serves every kernel (checked against finite differences in the tests).
 //!
 //! # Two implementations of the same formulas
-//! [`Problem`] for [`QuadFunctional`] runs the fast evaluator of the private `lanes` submodule
+//! [`Problem`] for [`QuadFunctional`] (every capability trait) runs the fast evaluator of the private `lanes` submodule
 //! (the four corners of a cell as SIMD lanes, per-cell first-contribution flags and CSR slot
 //! tables, AVX2 dispatch; its docs give the node-block formulas `H_PP = A + B + Bᵀ + C`,
 //! `H_PQ = −(A + Bᵀ)`, `H_PR = −(B + C)`, `H_QR = B` of a corner with leg blocks
@@ -40,7 +40,11 @@ use crate::assembly::{Assembly, SyncPtr, FIXED, FIXED_BIT};
 use crate::csr::Csr;
 use crate::error::FunctionalError;
 use crate::kernel::{KernelExpr, Order, Partials, Terms, TriKernel, TriScalars};
-use crate::problem::{LocalModel, Problem};
+#[cfg(doc)]
+use crate::problem::Problem;
+use crate::problem::{
+    Cost, ElementMeasures, Gradient, Hessian, LocalModel, PointwiseModel, Variables,
+};
 
 mod lanes;
 mod plan;
@@ -743,10 +747,10 @@ mod reference;
 
 /// A 2D functional: a [`QuadTopology`] (shared, cheap to clone) and a [`KernelExpr`].
 ///
-/// [`Problem`] is implemented by the fast evaluator (module `lanes`: four corner lanes per cell,
-/// precomputed index and slot tables, AVX2 when available), running the plan chosen for the
-/// expression (module `plan`: a fused kernel for the sums it knows, a loop over the terms
-/// otherwise).
+/// Every capability of [`Problem`] is implemented by the fast evaluator (module `lanes`: four
+/// corner lanes per cell, precomputed index and slot tables, AVX2 when available), running the
+/// plan chosen for the expression (module `plan`: a fused kernel for the sums it knows, a loop
+/// over the terms otherwise).
 #[derive(Debug, Clone)]
 pub struct QuadFunctional {
     topo: Arc<QuadTopology>,
@@ -802,7 +806,7 @@ impl QuadFunctional {
     }
 
     /// The per-triangle Hessian assembly with the plan's kernel (the fallback of
-    /// [`Problem::hessian`] when the slot tables cannot be built).
+    /// [`Hessian::hessian`] when the slot tables cannot be built).
     fn hessian_generic(&self, x: &[f64], h: &mut Csr) {
         with_plan!(self, k, t => self.hessian_per_triangle(k, t, x, h))
     }
@@ -817,7 +821,7 @@ impl QuadFunctional {
     }
 }
 
-impl Problem for QuadFunctional {
+impl Variables for QuadFunctional {
     fn dim(&self) -> usize {
         2
     }
@@ -830,7 +834,9 @@ impl Problem for QuadFunctional {
     fn var_of(&self, node: usize) -> Option<usize> {
         self.topo.var_of(node)
     }
+}
 
+impl Cost for QuadFunctional {
     fn value(&self, x: &[f64]) -> f64 {
         assert_eq!(
             x.len(),
@@ -841,7 +847,9 @@ impl Problem for QuadFunctional {
             lanes::value_chunk(&self.topo, k, t, x, s, e)
         }))
     }
+}
 
+impl Gradient for QuadFunctional {
     fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
         assert_eq!(
             x.len(),
@@ -859,7 +867,9 @@ impl Problem for QuadFunctional {
             lanes::grad_chunk(&self.topo, k, t, x, gp, s, e)
         }))
     }
+}
 
+impl Hessian for QuadFunctional {
     fn hessian_pattern(&self) -> Csr {
         self.topo.hessian_pattern()
     }
@@ -895,6 +905,9 @@ impl Problem for QuadFunctional {
             0.0
         }));
     }
+}
+
+impl PointwiseModel for QuadFunctional {
     /// Node-only local model (the node's 2 × 2 block of its leg pairs' Hessians, no 8 × 8 cell
     /// matrix), with the kernel of the fast evaluator's plan.
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
@@ -911,7 +924,9 @@ impl Problem for QuadFunctional {
         self.topo.var_of(node)?;
         with_plan!(self, k, t => node_value(k, t, &self.topo, x, node))
     }
+}
 
+impl ElementMeasures for QuadFunctional {
     fn num_elements(&self) -> usize {
         self.topo.num_triangles()
     }

@@ -13,7 +13,8 @@ mod common;
 
 use std::sync::Arc;
 
-use unamalla_functionals::{IvanenkoConvex, KernelExpr, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{IvanenkoConvex, KernelExpr, QuadFunctional, QuadTopology};
 use unamalla_mesh::{DVec2, StructuredGrid2};
 
 fn grid(t: f64) -> StructuredGrid2 {

@@ -14,9 +14,9 @@
 //!
 //! * `a-time`: best-of-`runs` wall time of Algorithm A alone (the `run_hex` driver with the
 //!   default options, perturbation seed 1) and of the Hessian refreshes inside it.
-//! * `a-variants`: the ω loop of Algorithm A re-run with (i) the reference Hessian assembly,
-//!   (ii) the Hessian refreshed only every k-th outer iteration, (iii) other ω₀ and ω factors;
-//!   prints iterations, Hessian refreshes, non-convex cells and seconds per variant.
+//! * `a-variants`: the ω loop of Algorithm A re-run with (i) the Hessian refreshed only every
+//!   k-th outer iteration, (ii) other ω₀ and ω factors; prints iterations, Hessian refreshes,
+//!   non-convex cells and seconds per variant.
 //! * `b-study`: Algorithm A then B with the given μ₀, μ_min and iterations per μ step, then an
 //!   analysis of the interior faces still at `|cos| ≥ 10⁻²`: their position in the interior
 //!   block (distance in cells to the block's surface) and the ratio of the reported measure
@@ -32,14 +32,15 @@
 //!   (the thesis's sphere ends at `f = 2.26543`); for the sphere also the same with a
 //!   different cube → ball map (Nowell's, see `nowell_ball`) to show how much the radial map
 //!   itself moves the optimum.
-//! * `hessian`: one Hessian refresh of `H_ω` on a folded `cells³` grid, node-block against
-//!   the reference assembly (best of `runs`).
+//! * `hessian`: one Hessian refresh of `H_ω` on a folded `cells³` grid (node-block assembly,
+//!   best of `runs`).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use unamalla_functionals::{Csr, HexFunctional, HexTopology, LocalModel, Problem, Scaling3};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{Csr, HexFunctional, HexTopology, Scaling3, WithHessian};
 use unamalla_hex::{run_hex, HexAlgorithm, HexCase, HexRunOptions};
 use unamalla_optim::monitor::Session;
 use unamalla_optim::solver::minimize_with;
@@ -64,35 +65,19 @@ fn cpu_seconds() -> f64 {
     (tick(11) + tick(12)) / 100.0
 }
 
-/// `H_ω` with a choice of Hessian assembly and refresh interval, counting refreshes.
+/// The Hessian of `H_ω` refreshed only every `every`-th time the solver asks (in between
+/// the previous values stay: a lagged model Hessian), counting refreshes and their time. It
+/// implements [`Hessian`] alone; the solver sees `WithHessian::new(&v.f, &v)`, which takes
+/// every other capability from the functional.
 struct Variant {
     f: HexFunctional,
-    reference: bool,
     every: usize,
     calls: AtomicUsize,
     refreshes: Arc<AtomicUsize>,
     hess_seconds: Arc<std::sync::Mutex<f64>>,
 }
 
-impl Problem for Variant {
-    fn dim(&self) -> usize {
-        3
-    }
-    fn num_vars(&self) -> usize {
-        self.f.num_vars()
-    }
-    fn free_nodes(&self) -> &[usize] {
-        self.f.free_nodes()
-    }
-    fn var_of(&self, node: usize) -> Option<usize> {
-        self.f.var_of(node)
-    }
-    fn value(&self, x: &[f64]) -> f64 {
-        self.f.value(x)
-    }
-    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
-        self.f.value_grad(x, g)
-    }
+impl Hessian for Variant {
     fn hessian_pattern(&self) -> Csr {
         self.f.hessian_pattern()
     }
@@ -102,11 +87,7 @@ impl Problem for Variant {
             return; // keep the previous values (lagged Hessian)
         }
         let t = Instant::now();
-        if self.reference {
-            self.f.hessian_reference(x, h);
-        } else {
-            self.f.hessian(x, h);
-        }
+        self.f.hessian(x, h);
         if let Ok(mut s) = self.hess_seconds.lock() {
             *s += t.elapsed().as_secs_f64();
         }
@@ -114,18 +95,6 @@ impl Problem for Variant {
     }
     fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
         self.f.hess_vec(x, v, out)
-    }
-    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
-        self.f.local(x, node)
-    }
-    fn num_elements(&self) -> usize {
-        self.f.num_elements()
-    }
-    fn element_measures(&self, x: &[f64], out: &mut [f64]) {
-        self.f.element_measures(x, out)
-    }
-    fn element_nodes(&self, e: usize, out: &mut Vec<usize>) {
-        self.f.element_nodes(e, out)
     }
 }
 
@@ -141,13 +110,7 @@ struct AOutcome {
 
 /// Algorithm A's ω loop (the same steps as `omega_continuation_hex`: minimize, stop when
 /// ε-convex, else ω ← factor·ω; then one refinement run with the ε guard).
-fn algorithm_a(
-    case: HexCase,
-    reference: bool,
-    every: usize,
-    omega0_rel: f64,
-    factor: f64,
-) -> AOutcome {
+fn algorithm_a(case: HexCase, every: usize, omega0_rel: f64, factor: f64) -> AOutcome {
     let dims = case.default_size();
     let mut g = case.initial_grid(dims).expect("grid");
     case.default_perturbation(dims)
@@ -173,7 +136,6 @@ fn algorithm_a(
     let hess_seconds = Arc::new(std::sync::Mutex::new(0.0));
     let make = |w: f64| Variant {
         f: HexFunctional::h_omega(topo.clone(), w, scaling).expect("functional"),
-        reference,
         every,
         calls: AtomicUsize::new(0),
         refreshes: refreshes.clone(),
@@ -187,7 +149,8 @@ fn algorithm_a(
     session.set_phase(Phase::Homotopic);
     let mut ok = false;
     loop {
-        let p = make(omega);
+        let v = make(omega);
+        let p = WithHessian::new(&v.f, &v);
         let r = minimize_with(&p, &mut x, &solver, &mut session, None).expect("minimize");
         iterations += r.iterations;
         steps += 1;
@@ -203,7 +166,8 @@ fn algorithm_a(
     if ok && opts.refinement {
         session.set_phase(Phase::Classic);
         session.guard_threshold = opts.eps * vbar;
-        let p = make(omega);
+        let v = make(omega);
+        let p = WithHessian::new(&v.f, &v);
         let r = minimize_with(&p, &mut x, &solver, &mut session, None).expect("refine");
         iterations += r.iterations;
         session.guard_threshold = 0.0;
@@ -256,19 +220,18 @@ fn a_variants(case: HexCase) {
         "variant", "it", "steps", "H-refresh", "H-seconds", "NC", "wall s", "CPU s"
     );
     let d = HexRunOptions::default().omega.omega0_rel;
-    let variants: Vec<(String, bool, usize, f64, f64)> = vec![
-        ("node-block Hessian (default)".into(), false, 1, d, 0.5),
-        ("reference Hessian".into(), true, 1, d, 0.5),
-        ("Hessian every 2nd iteration".into(), false, 2, d, 0.5),
-        ("Hessian every 3rd iteration".into(), false, 3, d, 0.5),
-        ("ω₀ = 1·v̄".into(), false, 1, 1.0, 0.5),
-        ("ω₀ = 0.01·v̄".into(), false, 1, 0.01, 0.5),
-        ("ω₀ = 0.001·v̄".into(), false, 1, 0.001, 0.5),
-        ("ω ← 0.1·ω".into(), false, 1, d, 0.1),
-        ("ω₀ = 0.01·v̄, ω ← 0.1·ω".into(), false, 1, 0.01, 0.1),
+    let variants: Vec<(String, usize, f64, f64)> = vec![
+        ("Hessian every iteration (default)".into(), 1, d, 0.5),
+        ("Hessian every 2nd iteration".into(), 2, d, 0.5),
+        ("Hessian every 3rd iteration".into(), 3, d, 0.5),
+        ("ω₀ = 1·v̄".into(), 1, 1.0, 0.5),
+        ("ω₀ = 0.01·v̄".into(), 1, 0.01, 0.5),
+        ("ω₀ = 0.001·v̄".into(), 1, 0.001, 0.5),
+        ("ω ← 0.1·ω".into(), 1, d, 0.1),
+        ("ω₀ = 0.01·v̄, ω ← 0.1·ω".into(), 1, 0.01, 0.1),
     ];
-    for (name, reference, every, w0, factor) in variants {
-        let o = algorithm_a(case, reference, every, w0, factor);
+    for (name, every, w0, factor) in variants {
+        let o = algorithm_a(case, every, w0, factor);
         println!(
             "{:<34} {:>5} {:>5} {:>9} {:>9.3} {:>4} {:>8.3} {:>8.2}",
             name,
@@ -309,22 +272,16 @@ fn hessian(cells: usize, runs: usize) {
         "first refresh (builds the slot table): {:.1} ms",
         1e3 * t.elapsed().as_secs_f64()
     );
-    for (name, reference) in [("node-block", false), ("reference", true)] {
-        let mut best = f64::INFINITY;
-        for _ in 0..runs {
-            let t = Instant::now();
-            if reference {
-                f.hessian_reference(&x, &mut h);
-            } else {
-                f.hessian(&x, &mut h);
-            }
-            best = best.min(t.elapsed().as_secs_f64());
-        }
-        println!(
-            "sphere {cells}³ cells, Hessian refresh {name}: best of {runs} {:.2} ms",
-            1e3 * best
-        );
+    let mut best = f64::INFINITY;
+    for _ in 0..runs {
+        let t = Instant::now();
+        f.hessian(&x, &mut h);
+        best = best.min(t.elapsed().as_secs_f64());
     }
+    println!(
+        "sphere {cells}³ cells, Hessian refresh (node-block): best of {runs} {:.2} ms",
+        1e3 * best
+    );
 }
 
 fn b_study(

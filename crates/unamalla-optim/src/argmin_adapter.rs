@@ -1,9 +1,13 @@
 //! Every [`Problem`] as an [argmin](https://argmin-rs.org) problem (feature `argmin`, on by
 //! default).
 //!
-//! [`ArgminProblem`] implements argmin's [`CostFunction`](argmin::core::CostFunction), [`Gradient`](argmin::core::Gradient) and [`Hessian`](argmin::core::Hessian) for any
+//! [`ArgminProblem`] implements argmin's [`CostFunction`](argmin::core::CostFunction),
+//! [`Gradient`](argmin::core::Gradient) and [`Hessian`](argmin::core::Hessian) for any
 //! functional of `unamalla-functionals` (quad and hex functionals alike, and any user type that
-//! implements [`Problem`]): the parameter vector is the problem's variable vector `Vec<f64>`
+//! implements the capability traits), each from the matching capability: argmin's cost from
+//! [`Cost`], its gradient from [`Gradient`], its Hessian from [`Hessian`] (all three also use
+//! [`Variables`] for the length check and [`ElementMeasures`] for the convexity guard), so a
+//! problem without a Hessian still runs argmin's L-BFGS. The parameter vector is the problem's variable vector `Vec<f64>`
 //! (free-node coordinates interleaved, see [`Problem`]) and the Hessian is a
 //! [`SparseHessian`], the assembled CSR matrix, which is the operator argmin's Newton-CG and
 //! Steihaug trust-region subproblem multiply with (`ArgminDot<Vec<f64>, Vec<f64>>`). So a user
@@ -56,7 +60,11 @@
 //! the inner CG iterations, and its `TrustRegion` uses the Euclidean norm (our TN-TR uses the
 //! preconditioner's norm); see docs/benchmarks.md for the timing comparison.
 
-use unamalla_functionals::{Csr, Problem};
+use std::sync::OnceLock;
+
+#[cfg(doc)]
+use unamalla_functionals::Problem;
+use unamalla_functionals::{Cost, Csr, ElementMeasures, Gradient, Hessian, Variables};
 
 use crate::monitor::{NullObserver, Session};
 
@@ -68,7 +76,7 @@ pub enum ArgminAdapterError {
     WrongLength {
         /// Entries of the vector passed.
         got: usize,
-        /// [`Problem::num_vars`].
+        /// [`Variables::num_vars`].
         expected: usize,
     },
     /// The guard's start point is not strictly inside the guard's admissible set.
@@ -84,11 +92,12 @@ pub enum ArgminAdapterError {
     },
 }
 
-/// A [`Problem`] seen through argmin's traits. See the [module docs](self).
+/// A [`Problem`] (or a part of one, see the [module docs](self)) seen through argmin's traits.
 #[derive(Debug, Clone)]
-pub struct ArgminProblem<'a, P: Problem + ?Sized> {
+pub struct ArgminProblem<'a, P: Variables + ElementMeasures + ?Sized> {
     problem: &'a P,
-    pattern: Csr,
+    /// The Hessian pattern, built at the first Hessian evaluation.
+    pattern: OnceLock<Csr>,
     guard: Option<Guard>,
 }
 
@@ -115,12 +124,13 @@ impl argmin_math::ArgminDot<Vec<f64>, Vec<f64>> for SparseHessian {
     }
 }
 
-impl<'a, P: Problem + ?Sized> ArgminProblem<'a, P> {
-    /// The plain problem: cost, gradient and Hessian of `problem`, no convexity guard.
+impl<'a, P: Variables + ElementMeasures + ?Sized> ArgminProblem<'a, P> {
+    /// The plain problem: cost, gradient and Hessian of `problem` (as far as it has them), no
+    /// convexity guard.
     pub fn new(problem: &'a P) -> Self {
         Self {
             problem,
-            pattern: problem.hessian_pattern(),
+            pattern: OnceLock::new(),
             guard: None,
         }
     }
@@ -193,7 +203,9 @@ impl<'a, P: Problem + ?Sized> ArgminProblem<'a, P> {
     }
 }
 
-impl<P: Problem + ?Sized> argmin::core::CostFunction for ArgminProblem<'_, P> {
+impl<P: Variables + Cost + ElementMeasures + ?Sized> argmin::core::CostFunction
+    for ArgminProblem<'_, P>
+{
     type Param = Vec<f64>;
     type Output = f64;
 
@@ -209,7 +221,9 @@ impl<P: Problem + ?Sized> argmin::core::CostFunction for ArgminProblem<'_, P> {
     }
 }
 
-impl<P: Problem + ?Sized> argmin::core::Gradient for ArgminProblem<'_, P> {
+impl<P: Variables + Gradient + ElementMeasures + ?Sized> argmin::core::Gradient
+    for ArgminProblem<'_, P>
+{
     type Param = Vec<f64>;
     type Gradient = Vec<f64>;
 
@@ -221,13 +235,18 @@ impl<P: Problem + ?Sized> argmin::core::Gradient for ArgminProblem<'_, P> {
     }
 }
 
-impl<P: Problem + ?Sized> argmin::core::Hessian for ArgminProblem<'_, P> {
+impl<P: Variables + Hessian + ElementMeasures + ?Sized> argmin::core::Hessian
+    for ArgminProblem<'_, P>
+{
     type Param = Vec<f64>;
     type Hessian = SparseHessian;
 
     fn hessian(&self, x: &Vec<f64>) -> Result<SparseHessian, argmin::core::Error> {
         self.check_len(x)?;
-        let mut h = self.pattern.clone();
+        let mut h = self
+            .pattern
+            .get_or_init(|| self.problem.hessian_pattern())
+            .clone();
         self.problem.hessian(x, &mut h);
         Ok(SparseHessian(h))
     }

@@ -2,10 +2,19 @@
 //!
 //! The optimization stage of unamalla: solvers for the discrete functionals of
 //! `unamalla-functionals` and the continuation drivers that make meshes convex and smooth.
-//! Design follows `argmin`'s separation: a [`Problem`](unamalla_functionals::Problem)
-//! (value, gradient, sparse Hessian / Hessian-vector product, local models, element
-//! measures), a solver ([`solver`]), an observer ([`monitor`]) and the convexity safeguard
-//! ([`safeguard`]). Sources are cited as `[Key, §x]` or `[Key, (eq)]`; the keys are listed in
+//! Design follows `argmin`'s separation: a problem made of small capability traits
+//! (`unamalla_functionals::problem`: [`Variables`](unamalla_functionals::Variables),
+//! [`Cost`](unamalla_functionals::Cost), [`Gradient`](unamalla_functionals::Gradient),
+//! [`Hessian`](unamalla_functionals::Hessian) — sparse matrix and Hessian-vector product —,
+//! [`PointwiseModel`](unamalla_functionals::PointwiseModel) and
+//! [`ElementMeasures`](unamalla_functionals::ElementMeasures); all six are a
+//! [`Problem`](unamalla_functionals::Problem)), a solver ([`solver`]), an observer
+//! ([`monitor`]) and the convexity safeguard ([`safeguard`]). The solver entry points take a
+//! `Problem` (the method is chosen at run time); the methods and the [`Session`] are bounded by
+//! the capabilities they use (L-BFGS and NCG never touch the Hessian, the safeguard only needs
+//! the element measures). A variant of a problem replaces one capability and keeps the rest:
+//! [`psd_model::PsdModel`] is a `Hessian` only, and
+//! [`WithHessian`](unamalla_functionals::WithHessian) combines it with the functional. Sources are cited as `[Key, §x]` or `[Key, (eq)]`; the keys are listed in
 //! `docs/references.md` of the repository.
 //!
 //! ## Solvers ([`solver`]; [González Flores, App. B])
@@ -30,7 +39,7 @@
 //! the assembled CSR Hessian; default), and a smoothed-aggregation multigrid V-cycle
 //! ([`multigrid`]) whose CG iteration count grows only slowly with the grid size. Hessian
 //! products use the assembled CSR matrix (refreshed once per outer iteration) or matrix-free
-//! `Problem::hess_vec`.
+//! [`Hessian::hess_vec`](unamalla_functionals::Hessian::hess_vec).
 //!
 //! **Why not `argmin`.** The solvers are written here, not taken from `argmin` 0.11, for
 //! correctness reasons: every trial point must pass the convexity safeguard below (argmin's
@@ -40,7 +49,8 @@
 //! verbatim for the UNAMALLA messages. (argmin 0.11 returns errors where older releases
 //! panicked, e.g. "Search direction must be a descent direction".) With feature `argmin`
 //! (default) every [`Problem`](unamalla_functionals::Problem) is an argmin problem
-//! ([`argmin_adapter`]); the timing comparison is in docs/benchmarks.md.
+//! ([`argmin_adapter`]: argmin's cost, gradient and Hessian from the matching capabilities);
+//! the timing comparison is in docs/benchmarks.md.
 //!
 //! ## Safeguard (the convexity contract)
 //! A [`Session`] finds the elements with at least one free vertex (by

@@ -1,23 +1,33 @@
-//! [`PsdModel`]: a quad functional whose [`Problem::hessian`] is the PSD-projected model
-//! Hessian of `unamalla_functionals::quad::psd` ([`HessianMode::ProjectedPsd`]).
+//! [`PsdModel`]: the PSD-projected model Hessian of `unamalla_functionals::quad::psd`
+//! ([`HessianMode::ProjectedPsd`]) as a [`Hessian`] over a borrowed quad functional.
 //!
-//! Value and gradient are the functional's own (exact), so every solver still minimizes the
+//! It implements [`Hessian`] only: the problem a solver minimizes is
+//! [`WithHessian`]`::new(&f, PsdModel::new(&f, mode))`, which takes every other capability
+//! (variables, value, gradient, local models, element measures) from `f` itself. Value and
+//! gradient are therefore the functional's own (exact), so every solver still minimizes the
 //! same `F` and the stopping tests (FTOL, GTOL) mean the same; only the quadratic model of
 //! truncated Newton changes: `m(z) = F + gᵀz + ½ zᵀ H⁺ z` with `H⁺ = Σ_T Pᵀ_T (H_u,T)⁺ P_T`
 //! (each corner triangle's 4×4 leg Hessian with its negative eigenvalues clamped to 0). `H⁺` is
 //! PSD, so preconditioned CG on it never meets negative curvature, the multigrid hierarchy is
 //! built on a semidefinite operator, and a step of the model is a descent direction.
 //!
-//! [`Problem::hess_vec`] stays the exact product (it is only used in
+//! The model is a [`Hessian`] implementation combined by [`WithHessian`] rather than a second
+//! Hessian argument of the solvers: the solvers, the session and the drivers keep seeing one
+//! problem per run, and a model changes no solver signature.
+//!
+//! [`Hessian::hess_vec`] stays the exact product (it is only used in
 //! [`HessianMode::MatrixFree`], where no model is assembled).
 
 use unamalla_functionals::quad::psd::PsdProjection;
-use unamalla_functionals::{Csr, LocalModel, Problem, QuadFunctional};
+use unamalla_functionals::{Csr, Hessian, QuadFunctional};
 
 #[cfg(doc)]
 use crate::solver::HessianMode;
+#[cfg(doc)]
+use unamalla_functionals::WithHessian;
 
-/// A borrowed quad functional with the PSD-projected model Hessian (module docs).
+/// The PSD-projected model Hessian of a borrowed quad functional (module docs); combine it
+/// with the functional by [`WithHessian`].
 #[derive(Debug, Clone, Copy)]
 pub struct PsdModel<'a> {
     f: &'a QuadFunctional,
@@ -25,55 +35,25 @@ pub struct PsdModel<'a> {
 }
 
 impl<'a> PsdModel<'a> {
-    /// Wraps `f`; `mode` chooses clamping (default) or absolute values of the negative
-    /// eigenvalues.
+    /// The model Hessian of `f`; `mode` chooses clamping (default) or absolute values of the
+    /// negative eigenvalues.
     pub fn new(f: &'a QuadFunctional, mode: PsdProjection) -> Self {
         Self { f, mode }
     }
 }
 
-impl Problem for PsdModel<'_> {
-    fn dim(&self) -> usize {
-        self.f.dim()
-    }
-    fn num_vars(&self) -> usize {
-        self.f.num_vars()
-    }
-    fn free_nodes(&self) -> &[usize] {
-        self.f.free_nodes()
-    }
-    fn var_of(&self, node: usize) -> Option<usize> {
-        self.f.var_of(node)
-    }
-    fn value(&self, x: &[f64]) -> f64 {
-        self.f.value(x)
-    }
-    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
-        self.f.value_grad(x, g)
-    }
+impl Hessian for PsdModel<'_> {
+    /// The functional's pattern (the projection keeps every corner triangle's 4×4 block).
     fn hessian_pattern(&self) -> Csr {
         self.f.hessian_pattern()
     }
+    /// `H⁺` at `x` ([`QuadFunctional::hessian_psd`]).
     fn hessian(&self, x: &[f64], h: &mut Csr) {
         self.f.hessian_psd(x, h, self.mode);
     }
+    /// The exact product `∇²F(x) v` (module docs).
     fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
         self.f.hess_vec(x, v, out)
-    }
-    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
-        self.f.local(x, node)
-    }
-    fn local_value(&self, x: &[f64], node: usize) -> Option<f64> {
-        self.f.local_value(x, node)
-    }
-    fn num_elements(&self) -> usize {
-        self.f.num_elements()
-    }
-    fn element_measures(&self, x: &[f64], out: &mut [f64]) {
-        self.f.element_measures(x, out)
-    }
-    fn element_nodes(&self, e: usize, out: &mut Vec<usize>) {
-        self.f.element_nodes(e, out)
     }
 }
 
@@ -83,6 +63,7 @@ mod tests {
     use crate::fixtures::sinusoidal;
     use crate::Solver;
     use crate::{smooth, HessianMode, NullObserver, Preconditioner, SmoothOptions, SolverOptions};
+    use unamalla_functionals::WithHessian;
 
     fn opts(hessian: HessianMode) -> SmoothOptions {
         SmoothOptions {
@@ -133,7 +114,7 @@ mod tests {
             topo.clone(),
             KernelExpr::weighted_sum(vec![(0.9, ao), (0.1, h)]),
         );
-        let m = PsdModel::new(&f, PsdProjection::Clamp);
+        let m = WithHessian::new(&f, PsdModel::new(&f, PsdProjection::Clamp));
         let x = topo.initial_x();
         let (mut he, mut hm) = (f.hessian_pattern(), m.hessian_pattern());
         f.hessian(&x, &mut he);

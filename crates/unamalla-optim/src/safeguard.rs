@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use unamalla_functionals::Problem;
+use unamalla_functionals::{ElementMeasures, Variables};
 
 use crate::monitor::{Control, Monitor, Observer, Phase, QualityProbe};
 
@@ -88,7 +88,7 @@ impl std::fmt::Debug for Session<'_> {
 impl<'o> Session<'o> {
     /// A session for `problem` (the element mask is found by perturbing the free variables of
     /// `x`: elements whose measure does not change have only fixed vertices).
-    pub fn new<P: Problem + ?Sized>(
+    pub fn new<P: Variables + ElementMeasures + ?Sized>(
         problem: &P,
         x: &[f64],
         observer: &'o mut dyn Observer,
@@ -136,7 +136,7 @@ impl<'o> Session<'o> {
     }
 
     /// Convexity statistics at `x`.
-    pub fn convexity<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64]) -> Convexity {
+    pub fn convexity<P: ElementMeasures + ?Sized>(&mut self, problem: &P, x: &[f64]) -> Convexity {
         problem.element_measures(x, &mut self.meas);
         let mut c = Convexity {
             min: f64::INFINITY,
@@ -176,7 +176,7 @@ impl<'o> Session<'o> {
     }
 
     /// Minimum masked measure at `x` (NaN measures count as `−∞`).
-    pub fn masked_min<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64]) -> f64 {
+    pub fn masked_min<P: ElementMeasures + ?Sized>(&mut self, problem: &P, x: &[f64]) -> f64 {
         problem.element_measures(x, &mut self.meas);
         let mut m = f64::INFINITY;
         for (&v, &k) in self.meas.iter().zip(&self.mask) {
@@ -228,14 +228,23 @@ impl<'o> Session<'o> {
     }
 
     /// `true` if `x_trial` keeps every masked element above the threshold.
-    pub fn admissible<P: Problem + ?Sized>(&mut self, problem: &P, x_trial: &[f64]) -> bool {
+    pub fn admissible<P: ElementMeasures + ?Sized>(
+        &mut self,
+        problem: &P,
+        x_trial: &[f64],
+    ) -> bool {
         self.masked_min(problem, x_trial) > self.threshold()
     }
 
     /// Fraction-to-boundary step: the largest `t > 0` such that every masked element stays
     /// above the threshold on `[0, t)` along `x + t·d`, computed exactly in 2D (α is quadratic
     /// in `t`: three evaluations at `t = −1, 0, 1`); `+∞` in 3D (where the search bisects).
-    pub fn max_step<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64], d: &[f64]) -> f64 {
+    pub fn max_step<P: Variables + ElementMeasures + ?Sized>(
+        &mut self,
+        problem: &P,
+        x: &[f64],
+        d: &[f64],
+    ) -> f64 {
         self.max_step_within(problem, x, d, f64::INFINITY)
     }
 
@@ -245,7 +254,7 @@ impl<'o> Session<'o> {
     /// `α(t) = a·t² + b·t + c₀` — skips the root computation (most elements of a smoothing
     /// step are far from the threshold), so the result is the same as `max_step`'s whenever
     /// that is below `horizon`.
-    pub fn max_step_within<P: Problem + ?Sized>(
+    pub fn max_step_within<P: Variables + ElementMeasures + ?Sized>(
         &mut self,
         problem: &P,
         x: &[f64],
@@ -271,8 +280,8 @@ impl<'o> Session<'o> {
     /// every node as soon as one cell sits at the safeguard's threshold — the situation of a
     /// smoothing run whose optimum has a few cells at the ε-convexity bound. Holding back
     /// only the blocking cells' nodes lets the rest of the mesh converge. Needs
-    /// [`Problem::element_nodes`]; without it `d` is unchanged.
-    pub fn hold_back<P: Problem + ?Sized>(
+    /// [`ElementMeasures::element_nodes`]; without it `d` is unchanged.
+    pub fn hold_back<P: Variables + ElementMeasures + ?Sized>(
         &mut self,
         problem: &P,
         x: &[f64],
@@ -382,7 +391,7 @@ impl<'o> Session<'o> {
 
     /// Records one iteration at `x` with value `f` and gradient norm `gnorm`, notifies the
     /// observer, and returns its verdict. Returns the convexity statistics for the solver.
-    pub fn iterate<P: Problem + ?Sized>(
+    pub fn iterate<P: ElementMeasures + ?Sized>(
         &mut self,
         problem: &P,
         x: &[f64],
@@ -425,7 +434,7 @@ struct StepScratch {
 impl StepScratch {
     /// The measures at the start point `x`, computed once per [`Session::max_step_within`] or
     /// [`Session::hold_back`] call (which asks for up to five directions from the same `x`).
-    fn measure_start<P: Problem + ?Sized>(&mut self, problem: &P, x: &[f64]) {
+    fn measure_start<P: ElementMeasures + ?Sized>(&mut self, problem: &P, x: &[f64]) {
         self.a0.resize(problem.num_elements(), 0.0);
         problem.element_measures(x, &mut self.a0);
     }
@@ -442,7 +451,7 @@ impl StepScratch {
 /// form `q = −(b + sign(b)·√(b² − 4ac))/2`, roots `q/a` and `c/q` (`c = α(0) − thr`). The
 /// elements are independent, so the loop runs in parallel; every time is computed by the
 /// same arithmetic whatever the thread count (and their minimum is exact).
-fn crossing_times<P: Problem + ?Sized>(
+fn crossing_times<P: ElementMeasures + ?Sized>(
     s: &mut StepScratch,
     problem: &P,
     x: &[f64],

@@ -3,15 +3,30 @@
 //! references are listed in `docs/references.md` of the repository; [Méndez 2023, §6.4.2] and
 //! [Cortés Aguirre 2012, §3.3] use TRON, a trust-region truncated Newton).
 //!
-//! All of them work on any [`Problem`] and report every iteration to a [`Session`], which
-//! also enforces the convexity safeguard: when the iterate is convex (every element with a
-//! free vertex above the session's threshold), trial points that are not are rejected.
+//! All of them report every iteration to a [`Session`], which also enforces the convexity
+//! safeguard: when the iterate is convex (every element with a free vertex above the session's
+//! threshold), trial points that are not are rejected. The entry points [`minimize`] and
+//! [`minimize_with`] choose the method at run time and take a [`Problem`] (every capability);
+//! the methods themselves use only part of it:
+//!
+//! | method | capabilities used |
+//! |---|---|
+//! | every method, the safeguard | [`Variables`], [`Gradient`], [`ElementMeasures`] |
+//! | truncated Newton | + [`Hessian`] (the quadratic model: assembled, or `hess_vec` matrix-free) |
+//! | L-BFGS, nonlinear CG | nothing more |
+//! | pointwise Newton | + [`PointwiseModel`], and [`Hessian::hessian_pattern`] for the node colouring |
+//!
+//! The model Hessian of truncated Newton is whatever the problem's [`Hessian`] gives: a model
+//! other than the exact Hessian (such as [`PsdModel`](crate::psd_model::PsdModel)) is supplied
+//! by replacing that capability alone with [`WithHessian`](unamalla_functionals::WithHessian).
 
 use std::str::FromStr;
 use std::sync::Arc;
 
 use rayon::prelude::*;
-use unamalla_functionals::{Csr, Problem, QuadTopology};
+use unamalla_functionals::{
+    Csr, ElementMeasures, Gradient, Hessian, PointwiseModel, Problem, QuadTopology, Variables,
+};
 
 use crate::error::OptimError;
 use crate::linalg::{
@@ -127,13 +142,14 @@ pub enum HessianMode {
     /// `≈ 12 bytes × 18 × 2 × free nodes` in 2D).
     #[default]
     Assembled,
-    /// Matrix-free products through [`Problem::hess_vec`] (no preconditioner is available
+    /// Matrix-free products through [`Hessian::hess_vec`] (no preconditioner is available
     /// then; Jacobi/block-Jacobi still use an assembled diagonal only in `Assembled` mode).
     MatrixFree,
-    /// Assembled like `Assembled`, but the drivers of quad functionals hand the solver a
-    /// [`PsdModel`](crate::psd_model::PsdModel): every corner triangle's leg Hessian projected
-    /// onto the PSD cone before assembly (`unamalla_functionals::quad::psd`), a Gauss–Newton-like
-    /// model whose CG never meets negative curvature. For any other [`Problem`] this is
+    /// Assembled like `Assembled`, but the drivers of quad functionals hand the solver the
+    /// functional with its [`Hessian`] replaced by a [`PsdModel`](crate::psd_model::PsdModel)
+    /// ([`WithHessian`](unamalla_functionals::WithHessian)): every corner triangle's leg
+    /// Hessian projected onto the PSD cone before assembly (`unamalla_functionals::quad::psd`),
+    /// a Gauss–Newton-like model whose CG never meets negative curvature. For any other [`Problem`] this is
     /// `Assembled` (the solver asks the problem for its Hessian). Used by `block_smoothing`
     /// ((6.8)) only. Measured (docs/benchmarks.md, "Large grids"): 8–14× slower than the exact
     /// Hessian on the sinusoidal 100² grid, because `F_AO`'s leg Hessian is indefinite for
@@ -438,7 +454,7 @@ impl QuadLocalGuard {
     }
 }
 
-fn check_start<P: Problem + ?Sized>(problem: &P, x: &[f64]) -> Result<(), OptimError> {
+fn check_start<P: Variables + ?Sized>(problem: &P, x: &[f64]) -> Result<(), OptimError> {
     if problem.num_vars() == 0 {
         return Err(OptimError::NoFreeNodes);
     }
@@ -555,7 +571,7 @@ struct State {
 impl State {
     /// Records an accepted iterate; returns a stop reason if a test fires.
     #[allow(clippy::too_many_arguments)]
-    fn accept<P: Problem + ?Sized>(
+    fn accept<P: ElementMeasures + ?Sized>(
         &mut self,
         problem: &P,
         x: &[f64],
@@ -725,14 +741,14 @@ fn steihaug(
     out
 }
 
-fn ensure_hessian<P: Problem + ?Sized>(problem: &P, session: &mut Session<'_>) {
+fn ensure_hessian<P: Variables + Hessian + ?Sized>(problem: &P, session: &mut Session<'_>) {
     let ok = matches!(&session.hess, Some(h) if h.nrows == problem.num_vars());
     if !ok {
         session.hess = Some(problem.hessian_pattern());
     }
 }
 
-fn truncated_newton<P: Problem + ?Sized>(
+fn truncated_newton<P: Variables + Gradient + Hessian + ElementMeasures + ?Sized>(
     problem: &P,
     x: &mut [f64],
     g: &mut [f64],
@@ -932,7 +948,7 @@ fn truncated_newton<P: Problem + ?Sized>(
     reason
 }
 
-fn lbfgs<P: Problem + ?Sized>(
+fn lbfgs<P: Variables + Gradient + ElementMeasures + ?Sized>(
     problem: &P,
     x: &mut [f64],
     g: &mut [f64],
@@ -1035,7 +1051,7 @@ fn lbfgs<P: Problem + ?Sized>(
 /// Returns the search's result and whether the cap was below the first trial step `stp0`, or
 /// the stop reason when no step was accepted.
 #[allow(clippy::too_many_arguments)]
-fn guarded_line_search<P: Problem + ?Sized>(
+fn guarded_line_search<P: Variables + Gradient + ElementMeasures + ?Sized>(
     problem: &P,
     x: &[f64],
     d: &[f64],
@@ -1089,7 +1105,7 @@ const NCG_WOLFE_GTOL: f64 = 0.1;
 
 /// Fletcher–Reeves nonlinear CG ([`Solver::NcgFr`]). The first trial step is `1/‖g‖` after a
 /// restart and otherwise `t_{k−1}·(g_{k−1}·d_{k−1})/(g_k·d_k)` (Nocedal & Wright 2006, (3.60)).
-fn ncg_fr<P: Problem + ?Sized>(
+fn ncg_fr<P: Variables + Gradient + ElementMeasures + ?Sized>(
     problem: &P,
     x: &mut [f64],
     g: &mut [f64],
@@ -1232,7 +1248,7 @@ fn local_step(m: &unamalla_functionals::LocalModel, comp: Option<usize>) -> [f64
     d
 }
 
-fn pointwise<P: Problem + ?Sized>(
+fn pointwise<P>(
     problem: &P,
     x: &mut [f64],
     g: &mut [f64],
@@ -1240,7 +1256,10 @@ fn pointwise<P: Problem + ?Sized>(
     session: &mut Session<'_>,
     st: &mut State,
     local_guard: Option<&QuadLocalGuard>,
-) -> StopReason {
+) -> StopReason
+where
+    P: Variables + Gradient + Hessian + PointwiseModel + ElementMeasures + ?Sized,
+{
     let dim = problem.dim();
     let ok = matches!(&session.colors, Some(c) if c.iter().map(Vec::len).sum::<usize>() * dim == problem.num_vars());
     if !ok {

@@ -7,9 +7,8 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use unamalla_functionals::{
-    AreaOrthogonality, HOmega, KernelExpr, Problem, QuadFunctional, QuadTopology,
-};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{AreaOrthogonality, HOmega, KernelExpr, QuadFunctional, QuadTopology};
 use unamalla_optim::fixtures::sinusoidal;
 use unamalla_optim::linalg::{dot, norm, PrecondApply};
 use unamalla_optim::multigrid::{Multigrid, MultigridOptions};

@@ -1,9 +1,12 @@
 //! Solvers on analytic problems with known minimizers (before any mesh).
 
-use unamalla_functionals::{Csr, LocalModel, Problem};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{Csr, LocalModel, WithHessian};
 use unamalla_optim::linesearch::LineSearchParams;
 use unamalla_optim::monitor::{Control, Monitor, NullObserver, Session};
-use unamalla_optim::solver::{minimize, PointwiseMode, Solver, SolverOptions};
+use unamalla_optim::solver::{minimize, HessianMode, PointwiseMode, Solver, SolverOptions};
 use unamalla_optim::status::StopReason;
 
 /// `F = ½ xᵀAx − bᵀx`, `A` = 2D "nodes on a chain" SPD matrix: node blocks `[[4, 1], [1, 3]]`
@@ -43,7 +46,7 @@ impl Quadratic {
     }
 }
 
-impl Problem for Quadratic {
+impl Variables for Quadratic {
     fn dim(&self) -> usize {
         2
     }
@@ -56,6 +59,9 @@ impl Problem for Quadratic {
     fn var_of(&self, node: usize) -> Option<usize> {
         (node < self.nodes).then_some(node)
     }
+}
+
+impl Cost for Quadratic {
     fn value(&self, x: &[f64]) -> f64 {
         let mut ax = vec![0.0; x.len()];
         self.apply(x, &mut ax);
@@ -63,6 +69,9 @@ impl Problem for Quadratic {
             .map(|i| 0.5 * x[i] * ax[i] - self.b[i] * x[i])
             .sum()
     }
+}
+
+impl Gradient for Quadratic {
     fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
         self.apply(x, g);
         for (gi, bi) in g.iter_mut().zip(&self.b) {
@@ -70,6 +79,9 @@ impl Problem for Quadratic {
         }
         self.value(x)
     }
+}
+
+impl Hessian for Quadratic {
     fn hessian_pattern(&self) -> Csr {
         let n = 2 * self.nodes;
         let mut ro = vec![0];
@@ -109,6 +121,9 @@ impl Problem for Quadratic {
     fn hess_vec(&self, _x: &[f64], v: &[f64], out: &mut [f64]) {
         self.apply(v, out)
     }
+}
+
+impl PointwiseModel for Quadratic {
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         if node >= self.nodes {
             return None;
@@ -122,6 +137,9 @@ impl Problem for Quadratic {
             dim: 2,
         })
     }
+}
+
+impl ElementMeasures for Quadratic {
     fn num_elements(&self) -> usize {
         0
     }
@@ -147,7 +165,7 @@ impl Rosenbrock {
     }
 }
 
-impl Problem for Rosenbrock {
+impl Variables for Rosenbrock {
     fn dim(&self) -> usize {
         2
     }
@@ -160,14 +178,23 @@ impl Problem for Rosenbrock {
     fn var_of(&self, node: usize) -> Option<usize> {
         (node == 0).then_some(0)
     }
+}
+
+impl Cost for Rosenbrock {
     fn value(&self, x: &[f64]) -> f64 {
         Self::gh(x).0
     }
+}
+
+impl Gradient for Rosenbrock {
     fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
         let (f, gg, _) = Self::gh(x);
         g.copy_from_slice(&gg);
         f
     }
+}
+
+impl Hessian for Rosenbrock {
     fn hessian_pattern(&self) -> Csr {
         Csr {
             nrows: 2,
@@ -187,6 +214,9 @@ impl Problem for Rosenbrock {
         out[0] = h[0][0] * v[0] + h[0][1] * v[1];
         out[1] = h[1][0] * v[0] + h[1][1] * v[1];
     }
+}
+
+impl PointwiseModel for Rosenbrock {
     fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
         (node == 0).then(|| {
             let (f, g, h) = Self::gh(x);
@@ -198,6 +228,9 @@ impl Problem for Rosenbrock {
             }
         })
     }
+}
+
+impl ElementMeasures for Rosenbrock {
     fn num_elements(&self) -> usize {
         0
     }
@@ -371,5 +404,92 @@ fn fletcher_reeves_ends_within_n_iterations_on_a_quadratic() {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         assert!(err < 1e-8, "{err}");
+    }
+}
+
+/// The Gauss–Newton model Hessian of [`Rosenbrock`], and nothing else: with the residuals
+/// `r₁ = 1 − a`, `r₂ = 10(b − a²)` (`F = r₁² + r₂²`) and `J = ∂r/∂(a, b) = [[−1, 0], [−20a, 10]]`,
+/// `H_GN = 2JᵀJ = [[2 + 800a², −400a], [−400a, 200]]` — the exact Hessian without the term
+/// `2r₂∇²r₂ = −400(b − a²)·e₁e₁ᵀ`, positive definite everywhere (`det = 400`). Counts its
+/// refreshes.
+struct GaussNewton {
+    refreshes: AtomicUsize,
+}
+
+impl GaussNewton {
+    fn h(x: &[f64]) -> [[f64; 2]; 2] {
+        let a = x[0];
+        [[2.0 + 800.0 * a * a, -400.0 * a], [-400.0 * a, 200.0]]
+    }
+}
+
+impl Hessian for GaussNewton {
+    fn hessian_pattern(&self) -> Csr {
+        Rosenbrock.hessian_pattern()
+    }
+    fn hessian(&self, x: &[f64], h: &mut Csr) {
+        self.refreshes.fetch_add(1, Ordering::Relaxed);
+        let m = Self::h(x);
+        h.values
+            .copy_from_slice(&[m[0][0], m[0][1], m[1][0], m[1][1]]);
+    }
+    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
+        let m = Self::h(x);
+        out[0] = m[0][0] * v[0] + m[0][1] * v[1];
+        out[1] = m[1][0] * v[0] + m[1][1] * v[1];
+    }
+}
+
+#[test]
+fn a_replaced_hessian_alone_drives_truncated_newton_to_the_same_minimizer() {
+    // the model Hessian at the start (−1.2, 1): [[2 + 800·1.44, 480], [480, 200]]
+    let gn = GaussNewton {
+        refreshes: AtomicUsize::new(0),
+    };
+    let p = WithHessian::new(&Rosenbrock, &gn);
+    let mut h = p.hessian_pattern();
+    p.hessian(&[-1.2, 1.0], &mut h);
+    for (v, e) in h.values.iter().zip([1154.0, 480.0, 480.0, 200.0]) {
+        assert!((v - e).abs() < 1e-12 * e, "{:?}", h.values);
+    }
+    // value and gradient are Rosenbrock's own: F(−1.2, 1) = 2.2² + 100·0.44² = 24.2,
+    // ∇F = (−2·2.2 − 400·(−1.2)·(−0.44), 200·(−0.44)) = (−215.6, −88)
+    let mut g = [0.0; 2];
+    let f0 = p.value_grad(&[-1.2, 1.0], &mut g);
+    assert!(
+        (f0 - 24.2).abs() < 1e-12 && (g[0] + 215.6).abs() < 1e-12 && (g[1] + 88.0).abs() < 1e-12
+    );
+    for (solver, hessian) in [
+        (Solver::TnTr, HessianMode::Assembled),
+        (Solver::TnLs, HessianMode::Assembled),
+        (Solver::TnTr, HessianMode::MatrixFree),
+    ] {
+        gn.refreshes.store(0, Ordering::Relaxed);
+        // field by field: the options may gain fields
+        let mut opts = SolverOptions::new(solver);
+        opts.max_iter = 5000;
+        opts.gtol = 1e-10;
+        opts.ftol = 0.0;
+        opts.hessian = hessian;
+        let mut x = vec![-1.2, 1.0];
+        let mut obs = NullObserver;
+        let mut s = Session::new(&p, &x, &mut obs);
+        let r = minimize(&p, &mut x, &opts, &mut s).unwrap();
+        // the minimizer (1, 1) and F = 0 of the formulas: the model changes the path only
+        assert!(
+            (x[0] - 1.0).abs() < 1e-6 && (x[1] - 1.0).abs() < 1e-6 && r.f < 1e-12,
+            "{solver:?} {hessian:?}: {x:?} {r:?}"
+        );
+        let used = gn.refreshes.load(Ordering::Relaxed);
+        if hessian == HessianMode::Assembled {
+            // one refresh per outer iteration (the last one may end without an accepted step)
+            assert!(
+                used > 0 && (r.iterations..=r.iterations + 1).contains(&used),
+                "{solver:?}: {used} refreshes, {} iterations",
+                r.iterations
+            );
+        } else {
+            assert_eq!(used, 0, "matrix-free products never assemble");
+        }
     }
 }

@@ -3,47 +3,19 @@
 
 use std::sync::Arc;
 
-use unamalla_functionals::{Csr, Length, LocalModel, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{Length, QuadFunctional, QuadTopology, WithMeasures};
 use unamalla_optim::drivers::{smooth, SmoothOptions};
 use unamalla_optim::fixtures::ivanenko;
 use unamalla_optim::monitor::{HistoryObserver, NullObserver, Session};
 use unamalla_optim::solver::{minimize_with, Solver, SolverOptions};
 
-/// The same problem without [`Problem::element_nodes`]: the safeguard can then only shorten
-/// the whole step (the behaviour before the held-back step existed).
+/// The measures of a quad functional without [`ElementMeasures::element_nodes`] (the trait's
+/// default, no nodes): combined with the functional by [`WithMeasures`], the safeguard can then
+/// only shorten the whole step (the behaviour before the held-back step existed).
 struct Anonymous<'a>(&'a QuadFunctional);
 
-impl Problem for Anonymous<'_> {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn num_vars(&self) -> usize {
-        self.0.num_vars()
-    }
-    fn free_nodes(&self) -> &[usize] {
-        self.0.free_nodes()
-    }
-    fn var_of(&self, node: usize) -> Option<usize> {
-        self.0.var_of(node)
-    }
-    fn value(&self, x: &[f64]) -> f64 {
-        self.0.value(x)
-    }
-    fn value_grad(&self, x: &[f64], g: &mut [f64]) -> f64 {
-        self.0.value_grad(x, g)
-    }
-    fn hessian_pattern(&self) -> Csr {
-        self.0.hessian_pattern()
-    }
-    fn hessian(&self, x: &[f64], h: &mut Csr) {
-        self.0.hessian(x, h)
-    }
-    fn hess_vec(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
-        self.0.hess_vec(x, v, out)
-    }
-    fn local(&self, x: &[f64], node: usize) -> Option<LocalModel> {
-        self.0.local(x, node)
-    }
+impl ElementMeasures for Anonymous<'_> {
     fn num_elements(&self) -> usize {
         self.0.num_elements()
     }
@@ -84,7 +56,7 @@ fn a_cell_at_the_threshold_is_held_back_and_the_rest_of_the_mesh_converges() {
     let f0 = p.value(&x0);
     let (f_free, min_free) = guarded_run(&p, &x0, f64::NEG_INFINITY, 300);
     let (f_held, min_held) = guarded_run(&p, &x0, thr, 300);
-    let (f_scaled, min_scaled) = guarded_run(&Anonymous(&p), &x0, thr, 300);
+    let (f_scaled, min_scaled) = guarded_run(&WithMeasures::new(&p, Anonymous(&p)), &x0, thr, 300);
     // the unguarded optimum goes below the threshold, so the guard really binds
     assert!(min_free < thr, "{min_free} ≥ {thr}");
     // the guarded runs stay above it (up to the safeguard's margin of 10⁻⁹·ᾱ per iteration

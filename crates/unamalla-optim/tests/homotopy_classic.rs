@@ -4,7 +4,8 @@
 
 use std::sync::Arc;
 
-use unamalla_functionals::{Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{QuadFunctional, QuadTopology};
 use unamalla_mesh::{DVec2, HasNodes, StructuredGrid2};
 use unamalla_optim::drivers::{
     adaptive_k, homotopy_weight, smooth, AdaptiveKOptions, ClassicCombination, HomotopySchedule,

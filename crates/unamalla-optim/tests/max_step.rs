@@ -6,7 +6,8 @@
 use std::sync::Arc;
 
 use proptest::prelude::*;
-use unamalla_functionals::{Length, Problem, QuadFunctional, QuadTopology};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::{Length, QuadFunctional, QuadTopology};
 use unamalla_optim::fixtures::sinusoidal;
 use unamalla_optim::monitor::{NullObserver, Session};
 

@@ -150,11 +150,11 @@ pub fn project_psd4(m: &mut [[f64; 4]; 4], mode: PsdProjection) -> bool {
 
 impl QuadFunctional {
     /// The PSD model Hessian (module docs) at `x`, written into `h` (which must come from
-    /// [`hessian_pattern`](crate::Problem::hessian_pattern)); returns the number of triangle
+    /// [`hessian_pattern`](crate::Hessian::hessian_pattern)); returns the number of triangle
     /// terms whose leg Hessian was projected.
     ///
     /// # Panics
-    /// As [`Problem::hessian`](crate::Problem::hessian): if `x` or `h` has the wrong size.
+    /// As [`Hessian::hessian`](crate::Hessian::hessian): if `x` or `h` has the wrong size.
     pub fn hessian_psd(&self, x: &[f64], h: &mut Csr, mode: PsdProjection) -> usize {
         self.check_hessian_args(x, h);
         with_plan!(self, k, t => psd_assemble(self, k, t, x, h, mode))

@@ -18,7 +18,7 @@ use crate::kernel::{Terms, TriKernel, TriScalars};
 mod fast_path;
 
 impl QuadFunctional {
-    /// The value with a single-threaded loop (same chunked summation as [`Problem::value`], so
+    /// The value with a single-threaded loop (same chunked summation as [`Cost::value`](crate::Cost::value), so
     /// the results are identical); useful as a reference.
     pub(crate) fn value_serial(&self, x: &[f64]) -> f64 {
         assert_eq!(
@@ -32,7 +32,7 @@ impl QuadFunctional {
     }
 
     /// Reference value: the per-triangle path with the kernel as given (no lanes, no
-    /// flattening). Equal to [`Problem::value`] up to rounding.
+    /// flattening). Equal to [`Cost::value`](crate::Cost::value) up to rounding.
     pub(crate) fn value_reference(&self, x: &[f64]) -> f64 {
         let reference = ExprKernel::new(&self.kernel);
         assert_eq!(
@@ -47,7 +47,7 @@ impl QuadFunctional {
     }
 
     /// Reference value and gradient (per-triangle path, zero then add). Equal to
-    /// [`Problem::value_grad`] up to rounding.
+    /// [`Gradient::value_grad`](crate::Gradient::value_grad) up to rounding.
     pub(crate) fn value_grad_reference(&self, x: &[f64], g: &mut [f64]) -> f64 {
         let reference = ExprKernel::new(&self.kernel);
         assert_eq!(
@@ -82,17 +82,17 @@ impl QuadFunctional {
     }
 
     /// Reference Hessian refresh (per-triangle 8×8 cell matrices, zero then add, neighbour
-    /// positions found by binary search). Equal to [`Problem::hessian`] up to rounding.
+    /// positions found by binary search). Equal to [`Hessian::hessian`](crate::Hessian::hessian) up to rounding.
     ///
     /// # Panics
-    /// As [`Problem::hessian`].
+    /// As [`Hessian::hessian`](crate::Hessian::hessian).
     pub(crate) fn hessian_reference(&self, x: &[f64], h: &mut Csr) {
         self.check_hessian_args(x, h);
         self.hessian_per_triangle(&ExprKernel::new(&self.kernel), self.terms, x, h);
     }
 
     /// Reference matrix-free Hessian-vector product (per-triangle 8×8 cell matrices). Equal to
-    /// [`Problem::hess_vec`] up to rounding.
+    /// [`Hessian::hess_vec`](crate::Hessian::hess_vec) up to rounding.
     pub(crate) fn hess_vec_reference(&self, x: &[f64], v: &[f64], out: &mut [f64]) {
         let reference = ExprKernel::new(&self.kernel);
         let n = self.topo.num_vars();

@@ -2,7 +2,8 @@
 //! derivative code: only `value` / `value_grad` are differentiated numerically).
 #![allow(dead_code, clippy::needless_range_loop)]
 
-use unamalla_functionals::{Csr, Problem};
+use unamalla_functionals::prelude::*;
+use unamalla_functionals::Csr;
 use unamalla_mesh::{DVec2, DVec3, StructuredGrid2, StructuredGrid3};
 
 /// An `m × n` grid on `[0, m-1] × [0, n-1]·aspect`, interior nodes moved by `amp·(r − ½)`

@@ -120,7 +120,8 @@ pub fn block_smoothing(
     }
     let run = |p: &QuadFunctional, x: &mut [f64], so: &SolverOptions, session: &mut Session<'_>| {
         if so.hessian == HessianMode::ProjectedPsd {
-            let model = PsdModel::new(p, PsdProjection::Clamp);
+            // the functional with its Hessian replaced by the PSD model
+            let model = WithHessian::new(p, PsdModel::new(p, PsdProjection::Clamp));
             minimize_with(&model, x, so, session, Some(&guard))
         } else {
             minimize_with(p, x, so, session, Some(&guard))

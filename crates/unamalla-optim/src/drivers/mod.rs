@@ -22,10 +22,11 @@ use std::str::FromStr;
 use std::sync::Arc;
 use std::time::Duration;
 
+use unamalla_functionals::prelude::*;
 use unamalla_functionals::{
     recommended_alpha_hat, Area, AreaOrthogonality, HOmega, HexFunctional, HexTopology,
-    IvanenkoConvex, KArea, KSmoothness, KernelExpr, Length, Orthogonality, Problem, QuadFunctional,
-    QuadTopology, Scaling3,
+    IvanenkoConvex, KArea, KSmoothness, KernelExpr, Length, Orthogonality, QuadFunctional,
+    QuadTopology, Scaling3, WithHessian,
 };
 use unamalla_mesh::{FreeNodes, HasHexCells, HasQuadCells};
 
@@ -181,7 +182,7 @@ fn start_record(c0: &crate::monitor::Convexity) -> (Init, Vec<Status>) {
 
 fn report(
     session: &mut Session<'_>,
-    problem: &dyn Problem,
+    problem: &dyn ElementMeasures,
     x: &[f64],
     init: &Init,
     messages: Vec<Status>,

@@ -76,7 +76,7 @@ pub fn omega_continuation(
 #[allow(clippy::too_many_arguments)]
 fn omega_loop<P: Problem>(
     session: &mut Session<'_>,
-    probe: &dyn Problem,
+    probe: &dyn ElementMeasures,
     x: &mut [f64],
     eps: f64,
     mean: f64,
