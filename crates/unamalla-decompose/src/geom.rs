@@ -162,38 +162,10 @@ pub(crate) fn hull_from_order(points: &[DVec2], order: &[HullKey]) -> (Vec<usize
         }
     }
     let distinct = idx.len() == points.len();
-    if idx.len() < 3 {
-        return (idx, distinct);
-    }
-    let mut hull: Vec<usize> = Vec::with_capacity(idx.len() * 2);
-    for pass in 0..2 {
-        let start = hull.len();
-        for k in 0..idx.len() {
-            let i = if pass == 0 {
-                idx[k]
-            } else {
-                idx[idx.len() - 1 - k]
-            };
-            while hull.len() >= start + 2 {
-                let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
-                if orient2d(points[a], points[b], points[i]) <= 0.0 {
-                    hull.pop();
-                } else {
-                    break;
-                }
-            }
-            hull.push(i);
-        }
-        hull.pop();
-    }
-    // rotate to start at the lowest-then-leftmost point
-    if let Some(k) = (0..hull.len()).min_by(|&a, &b| {
-        let (p, q) = (points[hull[a]], points[hull[b]]);
-        p.y.total_cmp(&q.y).then(p.x.total_cmp(&q.x))
-    }) {
-        hull.rotate_left(k);
-    }
-    (hull, distinct)
+    (
+        unamalla_mesh::geometry::hull_of_sorted(points, &idx),
+        distinct,
+    )
 }
 
 /// The [`hull_order`] of `child` from the hull order `parent_order` of `parent` (whose

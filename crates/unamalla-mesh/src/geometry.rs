@@ -109,15 +109,28 @@ pub fn convex_hull(points: &[DVec2]) -> Vec<usize> {
     if idx.len() < 3 {
         return idx;
     }
+    hull_of_sorted(points, &idx)
+}
+
+/// The two chains of Andrew's monotone chain and the rotation of [`convex_hull`], from `idx`:
+/// indices of pairwise different points of `points` sorted by `x`, then `y` (for instance
+/// after a sort and removal of equal points, as `convex_hull` does). Counter-clockwise,
+/// starting at the lowest-then-leftmost point, without collinear points (exact orientation).
+/// For callers that keep the sorted order of a point set and update it instead of sorting
+/// again.
+pub fn hull_of_sorted(points: &[DVec2], idx: &[usize]) -> Vec<usize> {
+    if idx.len() < 3 {
+        return idx.to_vec();
+    }
     let mut hull: Vec<usize> = Vec::with_capacity(idx.len() * 2);
     for pass in 0..2 {
         let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &usize>> = if pass == 0 {
-            Box::new(idx.iter())
-        } else {
-            Box::new(idx.iter().rev())
-        };
-        for &i in iter {
+        for k in 0..idx.len() {
+            let i = if pass == 0 {
+                idx[k]
+            } else {
+                idx[idx.len() - 1 - k]
+            };
             while hull.len() >= start + 2 {
                 let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
                 if orient2d(points[a], points[b], points[i]) <= 0.0 {
