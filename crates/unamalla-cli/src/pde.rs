@@ -210,11 +210,10 @@ pub fn run(a: PdeArgs) -> Result<()> {
         }
         s => crate::reliability::usage!("--solver: unknown solver '{s}' (sor, direct)"),
     };
-    let opts = SolveOptions {
-        method,
-        tol: a.tol,
-        max_iterations: a.max_iter,
-    };
+    let opts = SolveOptions::default()
+        .method(method)
+        .tol(a.tol)
+        .max_iterations(a.max_iter);
     let man = match &a.manufactured {
         Some(name) => Some(Manufactured::by_name(name).with_context(|| {
             format!("--manufactured: unknown solution '{name}' (sin-cosh, poly)")
@@ -309,10 +308,7 @@ pub fn run(a: PdeArgs) -> Result<()> {
             (l.min(v), h.max(v))
         });
     let err = man.as_ref().map(|m| m.error(&nodes, &sol.u));
-    let method_name = match sol.method {
-        Method::Sor { .. } => "sor",
-        Method::Direct => "direct",
-    };
+    let method_name = sol.method.name();
     if a.json {
         let v = serde_json::json!({
             "unknowns": sol.unknowns,

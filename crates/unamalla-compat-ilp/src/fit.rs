@@ -179,6 +179,22 @@ impl Default for FitOptions {
     }
 }
 
+impl FitOptions {
+    /// Sets [`backend`](Self::backend): MILP backend for systems that are not networks.
+    #[must_use]
+    pub fn backend(mut self, backend: MilpBackend) -> Self {
+        self.backend = backend;
+        self
+    }
+
+    /// Sets [`time_limit`](Self::time_limit): time limit (seconds) of the MILP call.
+    #[must_use]
+    pub fn time_limit(mut self, time_limit: Option<f64>) -> Self {
+        self.time_limit = time_limit;
+        self
+    }
+}
+
 /// The integer breakpoints of the deviation cost around a target `t`.
 #[derive(Debug, Clone, Copy)]
 struct Deviation {

@@ -98,6 +98,20 @@ impl IntervalOptions {
             backend: MilpBackend::Microlp,
         }
     }
+
+    /// Sets [`include_max_term`](Self::include_max_term).
+    #[must_use]
+    pub fn include_max_term(mut self, include_max_term: bool) -> Self {
+        self.include_max_term = include_max_term;
+        self
+    }
+
+    /// Sets [`backend`](Self::backend): MILP backend.
+    #[must_use]
+    pub fn backend(mut self, backend: MilpBackend) -> Self {
+        self.backend = backend;
+        self
+    }
 }
 
 /// Checks performed on a solution of (3).

@@ -75,6 +75,29 @@ impl SolveOptions {
         self.method = method;
         self
     }
+
+    /// Sets [`bounds`](Self::bounds): how the lower bounds are derived (density `d` or target cell
+    /// size `h`).
+    #[must_use]
+    pub fn bounds(mut self, bounds: LowerBounds) -> Self {
+        self.bounds = bounds;
+        self
+    }
+
+    /// Sets [`minimize_conflict`](Self::minimize_conflict).
+    #[must_use]
+    pub fn minimize_conflict(mut self, minimize_conflict: bool) -> Self {
+        self.minimize_conflict = minimize_conflict;
+        self
+    }
+
+    /// Sets [`time_limit`](Self::time_limit): time limit in seconds for each MILP call (`None`: no
+    /// limit).
+    #[must_use]
+    pub fn time_limit(mut self, time_limit: Option<f64>) -> Self {
+        self.time_limit = time_limit;
+        self
+    }
 }
 
 /// The solver path that produced a returned solution.

@@ -47,6 +47,29 @@ impl Default for MppOptions {
     }
 }
 
+impl MppOptions {
+    /// Sets [`tol`](Self::tol).
+    #[must_use]
+    pub fn tol(mut self, tol: f64) -> Self {
+        self.tol = tol;
+        self
+    }
+
+    /// Sets [`max_iter`](Self::max_iter): maximum SPG iterations per smoothing level.
+    #[must_use]
+    pub fn max_iter(mut self, max_iter: usize) -> Self {
+        self.max_iter = max_iter;
+        self
+    }
+
+    /// Sets [`levels`](Self::levels): number of smoothing levels: η = h·10^(−k), k = 0..levels.
+    #[must_use]
+    pub fn levels(mut self, levels: usize) -> Self {
+        self.levels = levels;
+        self
+    }
+}
+
 /// Outcome of an MPP solve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MppResult {

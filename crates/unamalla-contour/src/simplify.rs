@@ -222,6 +222,48 @@ impl SimplifyOptions {
             ..Self::default()
         }
     }
+
+    /// Sets [`method`](Self::method): the method.
+    #[must_use]
+    pub fn method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// Sets [`preset`](Self::preset): which defaults to use when `epsilon` / `delta` are not given.
+    #[must_use]
+    pub fn preset(mut self, preset: Preset) -> Self {
+        self.preset = preset;
+        self
+    }
+
+    /// Sets [`epsilon`](Self::epsilon): threshold ε (overrides the preset's).
+    #[must_use]
+    pub fn epsilon(mut self, epsilon: Option<f64>) -> Self {
+        self.epsilon = epsilon;
+        self
+    }
+
+    /// Sets [`delta`](Self::delta).
+    #[must_use]
+    pub fn delta(mut self, delta: Option<f64>) -> Self {
+        self.delta = delta;
+        self
+    }
+
+    /// Sets [`holes`](Self::holes): hole dropping.
+    #[must_use]
+    pub fn holes(mut self, holes: HoleFilter) -> Self {
+        self.holes = holes;
+        self
+    }
+
+    /// Sets [`mpp`](Self::mpp): MPP solver tuning.
+    #[must_use]
+    pub fn mpp(mut self, mpp: MppOptions) -> Self {
+        self.mpp = mpp;
+        self
+    }
 }
 
 /// Per-ring figures of a simplification.

@@ -61,6 +61,16 @@ impl Default for VerifyOptions {
     }
 }
 
+impl VerifyOptions {
+    /// Sets [`area_tolerance`](Self::area_tolerance): largest accepted relative area defect
+    /// `|A_mesh − A_Ω| / A_Ω`.
+    #[must_use]
+    pub fn area_tolerance(mut self, area_tolerance: f64) -> Self {
+        self.area_tolerance = area_tolerance;
+        self
+    }
+}
+
 /// The outcome of [`verify_quads`] / [`verify_hexes`]; `report.json` carries it as
 /// `verification`.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]

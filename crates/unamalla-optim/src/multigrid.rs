@@ -71,6 +71,37 @@ impl Default for MultigridOptions {
     }
 }
 
+impl MultigridOptions {
+    /// Sets [`coarse_size`](Self::coarse_size).
+    #[must_use]
+    pub fn coarse_size(mut self, coarse_size: usize) -> Self {
+        self.coarse_size = coarse_size;
+        self
+    }
+
+    /// Sets [`max_levels`](Self::max_levels): maximum number of levels (including the finest).
+    #[must_use]
+    pub fn max_levels(mut self, max_levels: usize) -> Self {
+        self.max_levels = max_levels;
+        self
+    }
+
+    /// Sets [`sweeps`](Self::sweeps): smoothing sweeps before and after the coarse correction
+    /// (`ν`).
+    #[must_use]
+    pub fn sweeps(mut self, sweeps: usize) -> Self {
+        self.sweeps = sweeps;
+        self
+    }
+
+    /// Sets [`strength`](Self::strength).
+    #[must_use]
+    pub fn strength(mut self, strength: f64) -> Self {
+        self.strength = strength;
+        self
+    }
+}
+
 /// One level above the coarsest: its operator (not stored for the finest level, which the
 /// caller passes to [`Multigrid::apply`]), its smoother and the transfer to the next level.
 #[derive(Debug, Clone)]

@@ -39,6 +39,36 @@ impl Default for ReportOptions {
     }
 }
 
+impl ReportOptions {
+    /// Sets [`histogram_bins`](Self::histogram_bins).
+    #[must_use]
+    pub fn histogram_bins(mut self, histogram_bins: usize) -> Self {
+        self.histogram_bins = histogram_bins;
+        self
+    }
+
+    /// Sets [`epsilon`](Self::epsilon).
+    #[must_use]
+    pub fn epsilon(mut self, epsilon: f64) -> Self {
+        self.epsilon = epsilon;
+        self
+    }
+
+    /// Sets [`tet_epsilon`](Self::tet_epsilon).
+    #[must_use]
+    pub fn tet_epsilon(mut self, tet_epsilon: f64) -> Self {
+        self.tet_epsilon = tet_epsilon;
+        self
+    }
+
+    /// Sets [`planarity_tolerance`](Self::planarity_tolerance).
+    #[must_use]
+    pub fn planarity_tolerance(mut self, planarity_tolerance: f64) -> Self {
+        self.planarity_tolerance = planarity_tolerance;
+        self
+    }
+}
+
 /// Which cells a report describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum CellKind {

@@ -64,6 +64,57 @@ pub struct ClassicOptions {
     pub solver: SolverOptions,
 }
 
+impl ClassicOptions {
+    /// The pair `combination` with weight `sigma`, no pre-smoothing, ε = 0.01 and the default
+    /// solver options (the values [`smooth`] uses for [`SmoothFunctional::Classic`] with the
+    /// default [`SmoothOptions`]).
+    pub fn new(combination: ClassicCombination, sigma: f64) -> Self {
+        Self {
+            combination,
+            sigma,
+            presmooth: 0,
+            eps: 0.01,
+            solver: SolverOptions::default(),
+        }
+    }
+
+    /// Sets [`combination`](Self::combination): the pair.
+    #[must_use]
+    pub fn combination(mut self, combination: ClassicCombination) -> Self {
+        self.combination = combination;
+        self
+    }
+
+    /// Sets [`sigma`](Self::sigma): σ, the weight of t-Area.
+    #[must_use]
+    pub fn sigma(mut self, sigma: f64) -> Self {
+        self.sigma = sigma;
+        self
+    }
+
+    /// Sets [`presmooth`](Self::presmooth): length pre-smoothing iterations (0 = "Previous
+    /// Smoothness: No").
+    #[must_use]
+    pub fn presmooth(mut self, presmooth: usize) -> Self {
+        self.presmooth = presmooth;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps): ε of the reported ε-convexity (`α₋ > ε·ᾱ`).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver): solver options.
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
+    }
+}
+
 /// Minimizes a classic combination ([`ClassicCombination`]) from `x` with the safeguard (a
 /// convex start stays convex). Unlike the adaptive functionals these do not untangle: the
 /// thesis reports none of its four test regions convex with t-Area–Length at σ = .5 or .95

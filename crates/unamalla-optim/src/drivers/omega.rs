@@ -35,6 +35,43 @@ impl Default for OmegaOptions {
     }
 }
 
+impl OmegaOptions {
+    /// Sets [`omega0_rel`](Self::omega0_rel).
+    #[must_use]
+    pub fn omega0_rel(mut self, omega0_rel: f64) -> Self {
+        self.omega0_rel = omega0_rel;
+        self
+    }
+
+    /// Sets [`omega_floor_rel`](Self::omega_floor_rel).
+    #[must_use]
+    pub fn omega_floor_rel(mut self, omega_floor_rel: f64) -> Self {
+        self.omega_floor_rel = omega_floor_rel;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps): ε of ε-convexity (`α₋ > ε·ᾱ`).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`refinement`](Self::refinement): run the refinement step after ε-convexity is reached.
+    #[must_use]
+    pub fn refinement(mut self, refinement: bool) -> Self {
+        self.refinement = refinement;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver).
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
+    }
+}
+
 /// [Cortés Aguirre 2012, §3.4, Algorithm A] on a quad mesh: minimize `H_ω` (normalized), halve `ω`
 /// until `α₋ > ε·ᾱ` or `ω` reaches the floor, then one refinement run (safeguarded at `ε·ᾱ`).
 pub fn omega_continuation(
