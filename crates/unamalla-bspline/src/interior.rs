@@ -43,6 +43,7 @@ use crate::net::ControlNet;
 
 /// Options of [`optimize_interior`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct InteriorOptions {
     /// `ω > 0` of `S_{ω,ε}` (first value; doubled if needed).
     pub omega: f64,

@@ -71,6 +71,7 @@ pub use sample::{sample_det_j, JacobianSample};
 
 /// Options of [`parametrize`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ParametrizeOptions {
     /// Bilinear or biquadratic map.
     pub degree: Degree,

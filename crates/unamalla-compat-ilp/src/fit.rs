@@ -163,6 +163,7 @@ impl FitTargets {
 
 /// Options of [`solve_fit`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct FitOptions {
     /// MILP backend for systems that are not networks.
     pub backend: MilpBackend,

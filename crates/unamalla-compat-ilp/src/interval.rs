@@ -80,6 +80,7 @@ pub struct IntervalProblem {
 
 /// Options of [`assign_intervals`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct IntervalOptions {
     /// Target element size `h`: `N_e = max(1, round(l(e)/h))` for edges without a prescription.
     pub target_size: f64,

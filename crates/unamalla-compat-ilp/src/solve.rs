@@ -29,6 +29,7 @@ impl Default for Method {
 
 /// Options of [`solve()`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SolveOptions {
     /// How the lower bounds are derived (density `d` or target cell size `h`).
     pub bounds: LowerBounds,

@@ -51,6 +51,7 @@ impl VertexKind {
 
 /// Options of [`classify_vertices`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct VertexClassOptions {
     /// Number of holes `H` (0: ILP (6); ≥ 1: ILP (8), global sum `4(1 − H)`).
     pub holes: usize,

@@ -28,6 +28,7 @@ use crate::error::ContourError;
 
 /// Tuning of the MPP solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct MppOptions {
     /// Stopping tolerance on the projected-gradient step, in units of the box half-width.
     pub tol: f64,

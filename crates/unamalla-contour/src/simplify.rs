@@ -198,6 +198,7 @@ pub fn hole_width(hole: &unamalla_mesh::Polygon) -> f64 {
 /// Options of [`simplify_region`]. `Default` is modified areas with the clean preset (ε = 1),
 /// all holes kept.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct SimplifyOptions {
     /// The method.
     pub method: Method,

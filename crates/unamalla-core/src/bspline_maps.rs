@@ -28,6 +28,7 @@ use crate::CoreError;
 
 /// Options of [`block_maps`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct BlockMapOptions {
     /// Samples per direction of the dense `det J` sample of each map.
     pub samples: usize,

@@ -45,6 +45,7 @@ pub const LISTED_CELLS: usize = 5;
 
 /// Tolerances of [`verify_quads`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct VerifyOptions {
     /// Largest accepted relative area defect `|A_mesh − A_Ω| / A_Ω`.
     pub area_tolerance: f64,

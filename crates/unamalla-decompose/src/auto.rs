@@ -46,6 +46,7 @@ impl Default for CutWeights {
 
 /// Options of [`decompose`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct DecomposeOptions {
     /// Concavity tolerances and the critical angle θ₋.
     pub tolerances: Tolerances,

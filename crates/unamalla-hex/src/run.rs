@@ -99,6 +99,7 @@ pub enum HexScaling {
 /// assert_eq!(opts.omega, defaults.omega);
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct HexRunOptions {
     /// A or A + B.
     pub algorithm: HexAlgorithm,

@@ -27,6 +27,7 @@ use crate::patches::BoundaryNames;
 
 /// How to read a region file.
 #[derive(Debug, Clone, Default)]
+#[non_exhaustive]
 pub struct LoadOptions {
     /// `KEY=VALUE` feature selector (see the module docs).
     pub feature: Option<String>,

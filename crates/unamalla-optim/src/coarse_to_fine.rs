@@ -44,6 +44,7 @@ use crate::monitor::Observer;
 
 /// Options of [`smooth_coarse_to_fine`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct CoarseToFineOptions {
     /// The smoothing of every level (functional, ε, solver); the finest level uses these
     /// solver tolerances (with [`crate::StopRules::polish`] when it starts from a prolongation).

@@ -12,6 +12,7 @@ use crate::status::LineSearchFailure;
 
 /// Parameters of the Moré–Thuente search.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct LineSearchParams {
     /// Sufficient-decrease constant `μ` (Armijo).
     pub ftol: f64,

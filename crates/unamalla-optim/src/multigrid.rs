@@ -49,6 +49,7 @@ use crate::linalg::{PrecondApply, Preconditioner};
 
 /// Options of the multigrid hierarchy.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct MultigridOptions {
     /// Stop coarsening when a level has at most this many unknowns (solved directly).
     pub coarse_size: usize,

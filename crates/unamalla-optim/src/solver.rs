@@ -143,6 +143,7 @@ pub enum HessianMode {
 
 /// Options of one solver run.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct SolverOptions {
     /// The method.
     pub solver: Solver,

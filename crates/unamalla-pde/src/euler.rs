@@ -83,6 +83,7 @@ pub enum EulerError {
 /// assert_eq!(EulerOptions::default().end_time(0.2).end_time, 0.2);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct EulerOptions {
     /// Ratio of specific heats `γ` (1.4).
     pub gamma: f64,

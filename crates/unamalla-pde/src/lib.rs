@@ -325,6 +325,7 @@ impl Method {
 /// assert_eq!(Method::Direct.name(), "direct");
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct SolveOptions {
     /// The solver.
     pub method: Method,

@@ -121,6 +121,7 @@ pub enum SumMode {
 
 /// Options of [`submap`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct SubmapOptions {
     /// Target element size `h` (region units): `N_e = max(1, round(l(e)/h))` and the CDT spacing.
     pub target_size: f64,

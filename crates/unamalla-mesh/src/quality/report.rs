@@ -15,6 +15,7 @@ use crate::traits::{HasHexCells, HasQuadCells};
 
 /// Options of [`QualityReport::for_quads_with`] / [`QualityReport::for_hexes_with`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct ReportOptions {
     /// Number of μ histogram bins over `[0, 1]` (default 20, bins of 0.05 as in the thesis's
     /// "0.95 ≤ μ ≤ 1" example).

@@ -105,6 +105,7 @@ pub fn homotopy_weight(
 
 /// Options of [`adaptive_k`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct AdaptiveKOptions {
     /// The functional pair.
     pub functional: KFunctional,

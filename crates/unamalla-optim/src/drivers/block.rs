@@ -5,6 +5,7 @@ use super::*;
 
 /// Options of [`block_smoothing`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct BlockSmoothingOptions {
     /// σ of (6.8): weight of `H_ω` (Laguna Honda example: 0.1).
     pub sigma: f64,

@@ -51,6 +51,7 @@ impl ClassicCombination {
 
 /// Options of [`classic_combination`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct ClassicOptions {
     /// The pair.
     pub combination: ClassicCombination,

@@ -5,6 +5,7 @@ use super::*;
 
 /// Options of Algorithm B ([`coplanarity_continuation`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct CoplanarityOptions {
     /// Fixed `ω` relative to the mean Jacobian ([Cortés Aguirre 2012, Algorithm B]: `10⁻⁸`).
     pub omega_rel: f64,

@@ -5,6 +5,7 @@ use super::*;
 
 /// Options of Algorithm A ([`omega_continuation`], [`omega_continuation_hex`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct OmegaOptions {
     /// `ω₀` in units of the mean measure (`ᾱ` or the mean tetrahedron Jacobian).
     pub omega0_rel: f64,

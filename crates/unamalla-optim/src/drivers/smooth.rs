@@ -137,6 +137,7 @@ impl FromStr for SmoothFunctional {
 
 /// Options of [`smooth`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct SmoothOptions {
     /// The functional / driver.
     pub functional: SmoothFunctional,
@@ -413,6 +414,7 @@ pub enum HexDriver {
 
 /// Options of [`smooth_hex`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct HexSmoothOptions {
     /// Which algorithms.
     pub driver: HexDriver,
