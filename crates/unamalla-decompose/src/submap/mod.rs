@@ -189,6 +189,7 @@ impl SubmapOptions {
 
 /// Why submapping failed. Every variant names the ring, hole, piece or point concerned.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SubmapError {
     /// The target size is not a finite positive number.
     #[error("submapping: target size must be finite and > 0, got {0}")]
