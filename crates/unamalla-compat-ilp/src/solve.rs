@@ -13,6 +13,7 @@ use crate::verify::{check, Optimality, Verification};
 /// Which method to try first. Whatever is chosen, every candidate is verified and the other paths are
 /// used as fallbacks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Method {
     /// The MILP of (5.10) in its direct form through `good_lp` (default: `microlp`).
     Milp(MilpBackend),

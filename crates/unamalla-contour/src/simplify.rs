@@ -38,6 +38,7 @@ use crate::removal::{batch, sequential, Stop, Workspace};
 /// their first step always uses the thesis's fixed value (1e-4, resp. 0.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
 pub enum Method {
     /// Scaled Visvalingam (§3.1.1, Obs 3.1): repeatedly remove the vertex of smallest triangle
     /// area while that area is below `ε · ā`, `ā` the mean triangle area of the input ring
@@ -160,6 +161,7 @@ impl FromStr for Method {
 /// Which set of default thresholds to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
 pub enum Preset {
     /// No noise: simplification thresholds (e.g. modified three-step δ = 1e-5, ε = 0.1).
     #[default]
@@ -173,6 +175,7 @@ pub enum Preset {
 /// Which holes to drop before simplifying (the thesis recommends removing negligible holes
 /// before meshing, Obs A.1).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum HoleFilter {
     /// Keep every hole.
     #[default]

@@ -100,6 +100,7 @@ pub struct DecomposeOptions {
 
 /// How the first cuts of a decomposition are placed (crate docs, "Layouts").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Layout {
     /// The thesis's Algorithm 1 alone: hole removal (Algorithm 2) and concavity cuts
     /// (Algorithm 3) from the deepest reflex vertices.

@@ -23,6 +23,7 @@ use crate::{HexError, HexRunReport};
 /// How the start is perturbed ([`perturb_interior`]: each free node moves by
 /// `s·h_v·u`, `h_v` its shortest edge, `u` uniform in the unit ball).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Perturbation {
     /// No perturbation.
     None,
@@ -56,6 +57,7 @@ impl Perturbation {
 
 /// Which algorithms to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum HexAlgorithm {
     /// Algorithm A only.
     A,
@@ -68,6 +70,7 @@ pub enum HexAlgorithm {
 /// but its reported values fit only unit-parametric Jacobians (our reading; see
 /// `unamalla_functionals::hex`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum HexScaling {
     /// Raw vertex differences, as printed in the thesis.
     Index,

@@ -23,6 +23,7 @@ use crate::status::{LineSearchFailure, StopReason};
 
 /// The optimization method (names as accepted by `unamalla smooth --solver`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum Solver {
     /// `tn-tr`: truncated Newton with a trust region (Steihaug–CG, negative-curvature exit);
     /// UNAMALLA's default and the TRON family of [Méndez 2023, §6.4.2] and
@@ -87,6 +88,7 @@ impl FromStr for Solver {
 
 /// Mode of pointwise Newton (UNAMALLA "Newton Point to Point").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum PointwiseMode {
     /// Solve the local 2×2 (3×3) Newton system.
     #[default]
@@ -122,6 +124,7 @@ impl FromStr for PointwiseMode {
 
 /// How truncated Newton forms Hessian-vector products.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum HessianMode {
     /// Assemble the sparse Hessian once per outer iteration and multiply (fast; memory
     /// `≈ 12 bytes × 18 × 2 × free nodes` in 2D).

@@ -283,6 +283,7 @@ impl Equation {
 
 /// Which linear solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Method {
     /// Successive over-relaxation; `omega: None` chooses ω automatically (module docs).
     Sor {

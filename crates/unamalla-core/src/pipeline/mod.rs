@@ -106,6 +106,7 @@ impl Default for MeshSize {
 /// The decomposition strategy (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "snake_case")]
+#[non_exhaustive]
 pub enum Strategy {
     /// Straight cuts into admissible blocks with four corners ([Méndez 2023, Ch. 4]).
     #[default]

@@ -5,6 +5,7 @@ use super::*;
 
 /// The adaptive functional `f₁` and its partner `f₂` ([González Flores, Table 5.2, §A.4.3]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum KFunctional {
     /// `kSmooth-Area`: k-Smoothness with Area.
     KSmoothArea,
@@ -23,6 +24,7 @@ pub enum KFunctional {
 /// `t = (k₀ − k)/(k₀ − k*)` ((5.20) is the linear path), so the weight of the classic functional
 /// `f₂` is `σ̂ = (1 − σ)·σ̃(t)` (5.19) ([`homotopy_weight`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum HomotopySchedule {
     /// `σ̃(t) = t`: the linear homotopy (5.20), UNAMALLA's practical scheme.
     #[default]

@@ -7,6 +7,7 @@ use super::*;
 /// `Area-Ortho.` entries of the Functional menu), each the convex combination `σ·F̃₁ + (1 − σ)·F̃₂`
 /// of normalized functionals (§5.1; σ is the weight of the first-named functional, (5.1)–(5.2)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum ClassicCombination {
     /// t-Area – Length: `σ·Σα²/(Nᾱ²) + (1 − σ)·Σl/(2Nᾱ)` (Table 5.1 weights .95, .7, .5; the
     /// text recommends 0.9 as an automatic value; the menu's default is 0.5).

@@ -5,6 +5,7 @@ use super::*;
 
 /// The functional (and driver) of [`smooth`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum SmoothFunctional {
     /// `ao-homega`: [Méndez 2023, (6.8), (6.9)] with the ε-convexity guarantee
     /// ([`block_smoothing`]).
@@ -404,6 +405,7 @@ where
 
 /// Which hexahedral driver [`smooth_hex`] runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum HexDriver {
     /// Algorithm A only.
     #[default]
