@@ -59,13 +59,11 @@ fn case(n: usize) -> Case {
     let x0 = topo.initial_x();
     let f = QuadFunctional::new(topo, Smoothness::new());
     let mut x = x0.clone();
-    let opts = SolverOptions {
-        max_iter: 1000,
-        ftol: 0.0,
-        gtol: 1e-10,
-        preconditioner: Preconditioner::Multigrid,
-        ..SolverOptions::new(Solver::TnTr)
-    };
+    let opts = SolverOptions::new(Solver::TnTr)
+        .max_iter(1000)
+        .ftol(0.0)
+        .gtol(1e-10)
+        .preconditioner(Preconditioner::Multigrid);
     let mut obs = NullObserver;
     let mut session = Session::new(&f, &x, &mut obs);
     let r = minimize(&f, &mut x, &opts, &mut session).expect("reference run");
@@ -82,18 +80,16 @@ fn case(n: usize) -> Case {
 /// One run of our solver `s` to the target: (iterations, final F, convex).
 fn ours(c: &Case, s: Solver) -> (usize, f64, bool) {
     let mut x = c.x0.clone();
-    let opts = SolverOptions {
-        max_iter: if s == Solver::Lbfgs {
+    let opts = SolverOptions::new(s)
+        .max_iter(if s == Solver::Lbfgs {
             CAP_LBFGS as usize
         } else {
             CAP_NEWTON as usize
-        },
-        ftol: 0.0,
-        gtol: 0.0,
-        lbfgs_memory: 5,
-        preconditioner: Preconditioner::Multigrid,
-        ..SolverOptions::new(s)
-    };
+        })
+        .ftol(0.0)
+        .gtol(0.0)
+        .lbfgs_memory(5)
+        .preconditioner(Preconditioner::Multigrid);
     let target = c.target;
     let mut obs = |m: &Monitor| {
         if m.f <= target {

@@ -82,10 +82,7 @@ fn bench_decompose(c: &mut Criterion) {
             .expect("prepare");
         let r = prepared.mesh_region;
         // as the pipeline does: the chord layouts sample the boundary at the cell size
-        let opts = DecomposeOptions {
-            cell_size: Some((r.area() / cells as f64).sqrt()),
-            ..DecomposeOptions::default()
-        };
+        let opts = DecomposeOptions::default().cell_size(Some((r.area() / cells as f64).sqrt()));
         group.bench_with_input(BenchmarkId::new(name, cells), &r, |b, r| {
             b.iter(|| choose_layout(r, &opts, MeshSize::Cells(cells)).expect("layout"))
         });
@@ -126,10 +123,7 @@ fn bench_smooth(c: &mut Criterion) {
     group.measurement_time(Duration::from_secs(20));
     for n in [300usize, 1000] {
         let g0 = sinusoidal(n, n, 0.1, 2.0).expect("sinusoidal grid");
-        let opts = CoarseToFineOptions {
-            smooth: default_smooth_options(),
-            ..CoarseToFineOptions::default()
-        };
+        let opts = CoarseToFineOptions::default().smooth(default_smooth_options());
         group.bench_with_input(BenchmarkId::from_parameter(n), &g0, |b, g0| {
             b.iter_batched(
                 || g0.clone(),

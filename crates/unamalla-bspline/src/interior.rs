@@ -43,6 +43,7 @@ use crate::net::ControlNet;
 
 /// Options of [`optimize_interior`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct InteriorOptions {
     /// `ω > 0` of `S_{ω,ε}` (first value; doubled if needed).
     pub omega: f64,
@@ -63,11 +64,46 @@ impl Default for InteriorOptions {
             eps: 0.05,
             sigma: 0.5,
             omega_doublings: 3,
-            solver: SolverOptions {
-                max_iter: 500,
-                ..SolverOptions::default()
-            },
+            solver: SolverOptions::default().max_iter(500),
         }
+    }
+}
+
+impl InteriorOptions {
+    /// Sets [`omega`](Self::omega): `ω > 0` of `S_{ω,ε}` (first value; doubled if needed).
+    #[must_use]
+    pub fn omega(mut self, omega: f64) -> Self {
+        self.omega = omega;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`sigma`](Self::sigma).
+    #[must_use]
+    pub fn sigma(mut self, sigma: f64) -> Self {
+        self.sigma = sigma;
+        self
+    }
+
+    /// Sets [`omega_doublings`](Self::omega_doublings): how many times ω may be doubled when the
+    /// result is not ε-convex.
+    #[must_use]
+    pub fn omega_doublings(mut self, omega_doublings: usize) -> Self {
+        self.omega_doublings = omega_doublings;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver): the solver and its stopping options.
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
     }
 }
 

@@ -27,7 +27,7 @@
 //! use unamalla_bspline::{parametrize, synthetic::Synthetic, Degree, ParametrizeOptions};
 //!
 //! let boundary = Synthetic::S2Wavy.boundary(12, 12)?;
-//! let opts = ParametrizeOptions { degree: Degree::Biquadratic, samples: 200, ..Default::default() };
+//! let opts = ParametrizeOptions::default().degree(Degree::Biquadratic).samples(200);
 //! let p = parametrize(&boundary, &opts)?;
 //! assert!(p.interior.convex);                  // the optimized net is convex …
 //! assert!(p.certificates.theorem1.holds);      // … so its bilinear map is injective (Thm 1)
@@ -71,6 +71,7 @@ pub use sample::{sample_det_j, JacobianSample};
 
 /// Options of [`parametrize`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ParametrizeOptions {
     /// Bilinear or biquadratic map.
     pub degree: Degree,
@@ -90,6 +91,37 @@ impl Default for ParametrizeOptions {
             samples: 1000,
             subdivision: 4,
         }
+    }
+}
+
+impl ParametrizeOptions {
+    /// Sets [`degree`](Self::degree): bilinear or biquadratic map.
+    #[must_use]
+    pub fn degree(mut self, degree: Degree) -> Self {
+        self.degree = degree;
+        self
+    }
+
+    /// Sets [`interior`](Self::interior): the interior optimization.
+    #[must_use]
+    pub fn interior(mut self, interior: InteriorOptions) -> Self {
+        self.interior = interior;
+        self
+    }
+
+    /// Sets [`samples`](Self::samples): samples per direction of the dense `det J` sample (the
+    /// paper: 10⁴).
+    #[must_use]
+    pub fn samples(mut self, samples: usize) -> Self {
+        self.samples = samples;
+        self
+    }
+
+    /// Sets [`subdivision`](Self::subdivision): maximum subdivision depth of the Bernstein test.
+    #[must_use]
+    pub fn subdivision(mut self, subdivision: usize) -> Self {
+        self.subdivision = subdivision;
+        self
     }
 }
 

@@ -197,11 +197,10 @@ pub fn run(a: BsplineArgs) -> Result<()> {
                 result.mesh.blocks().len()
             );
         }
-        let opts = BlockMapOptions {
-            samples: a.samples,
-            subdivision: a.subdivide,
-            biquadratic: degree == Degree::Biquadratic,
-        };
+        let opts = BlockMapOptions::default()
+            .samples(a.samples)
+            .subdivision(a.subdivide)
+            .biquadratic(degree == Degree::Biquadratic);
         let maps = block_maps(&result.mesh, &opts)?;
         let mut blocks = Vec::new();
         let mut min_det = f64::INFINITY;
@@ -293,11 +292,7 @@ pub fn run(a: BsplineArgs) -> Result<()> {
         if !a.quiet {
             eprintln!("· {name}: {n}x{m} control net; optimizing the interior control points");
         }
-        let iopts = InteriorOptions {
-            omega: a.omega,
-            eps: a.eps,
-            ..InteriorOptions::default()
-        };
+        let iopts = InteriorOptions::default().omega(a.omega).eps(a.eps);
         let interior = optimize_interior(&mut net, &iopts)?;
         let map = TensorMap::new(degree, net)?;
         if !a.quiet {

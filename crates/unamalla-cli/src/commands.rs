@@ -77,10 +77,9 @@ fn parse_exports(s: &str) -> Result<Exports> {
 /// Reads a region of any supported format (see [`io::input`]), printing the notes (unless
 /// `quiet`) and any warning.
 fn load_region(path: &Path, gis: &SolverGisArgs, quiet: bool) -> Result<io::LoadedRegion> {
-    let opts = io::LoadOptions {
-        feature: gis.feature.clone(),
-        crs: gis.crs.parse()?,
-    };
+    let opts = io::LoadOptions::default()
+        .feature(gis.feature.clone())
+        .crs(gis.crs.parse()?);
     let l = io::load_region(path, &opts)?;
     if !quiet {
         for n in &l.notes {
@@ -571,11 +570,9 @@ impl SmoothFlags {
         if let Some(s) = self.sigma {
             functional = functional.with_sigma(s)?;
         }
-        let mut opts = SmoothOptions {
-            functional,
-            presmooth: self.presmooth,
-            ..SmoothOptions::default()
-        };
+        let mut opts = SmoothOptions::default()
+            .functional(functional)
+            .presmooth(self.presmooth);
         opts.solver.solver = self.solver.parse::<optim::solver::Solver>()?;
         if let Some(m) = self.lbfgs_memory {
             opts.solver.lbfgs_memory = m;
@@ -648,12 +645,10 @@ pub fn simplify(
     svg: Option<&Path>,
 ) -> Result<()> {
     let region = reliability::read_one_region(path, part)?;
-    let opts = SimplifyOptions {
-        method: method.parse()?,
-        epsilon,
-        delta,
-        ..SimplifyOptions::default()
-    };
+    let opts = SimplifyOptions::default()
+        .method(method.parse()?)
+        .epsilon(epsilon)
+        .delta(delta);
     let r = contour::simplify_region(&region, &opts)?;
     let overlay = svg.map(|_| contour::overlay_svg(&region, &r.region));
     writing(out, || {

@@ -109,10 +109,9 @@ pub fn run(a: HexArgs) -> Result<()> {
     };
     let mut coplanarity = match a.b_schedule.to_ascii_lowercase().as_str() {
         "default" => HexRunOptions::default().coplanarity,
-        "thesis" => CoplanarityOptions {
-            solver: HexRunOptions::default().coplanarity.solver,
-            ..CoplanarityOptions::thesis()
-        },
+        "thesis" => {
+            CoplanarityOptions::thesis().solver(HexRunOptions::default().coplanarity.solver)
+        }
         other => {
             crate::reliability::usage!("--b-schedule must be 'default' or 'thesis', got '{other}'")
         }
@@ -183,11 +182,9 @@ pub fn run(a: HexArgs) -> Result<()> {
             a.seed
         );
     }
-    let mut opts = HexRunOptions {
-        algorithm,
-        scaling,
-        ..HexRunOptions::default()
-    };
+    let mut opts = HexRunOptions::default()
+        .algorithm(algorithm)
+        .scaling(scaling);
     coplanarity.mu0 = mu0;
     coplanarity.mu_min = a.mu_min;
     opts.coplanarity = coplanarity;

@@ -212,11 +212,10 @@ pub fn run(a: PdeArgs) -> Result<()> {
         }
         s => crate::reliability::usage!("--solver: unknown solver '{s}' (sor, direct)"),
     };
-    let opts = SolveOptions {
-        method,
-        tol: a.tol,
-        max_iterations: a.max_iter,
-    };
+    let opts = SolveOptions::default()
+        .method(method)
+        .tol(a.tol)
+        .max_iterations(a.max_iter);
     let nodes: Vec<_> = match &mesh {
         InputMesh::Grid(g) => unamalla_core::mesh::HasNodes::nodes(g).to_vec(),
         InputMesh::Quads(q) => unamalla_core::mesh::HasNodes::nodes(q).to_vec(),
@@ -321,10 +320,7 @@ pub fn run(a: PdeArgs) -> Result<()> {
             (l.min(v), h.max(v))
         });
     let err = man.as_ref().map(|m| m.error(&nodes, &sol.u));
-    let method_name = match sol.method {
-        Method::Sor { .. } => "sor",
-        Method::Direct => "direct",
-    };
+    let method_name = sol.method.name();
     if a.json {
         let v = serde_json::json!({
             "unknowns": sol.unknowns,

@@ -163,6 +163,7 @@ impl FitTargets {
 
 /// Options of [`solve_fit`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct FitOptions {
     /// MILP backend for systems that are not networks.
     pub backend: MilpBackend,
@@ -176,6 +177,22 @@ impl Default for FitOptions {
             backend: MilpBackend::Microlp,
             time_limit: Some(60.0),
         }
+    }
+}
+
+impl FitOptions {
+    /// Sets [`backend`](Self::backend): MILP backend for systems that are not networks.
+    #[must_use]
+    pub fn backend(mut self, backend: MilpBackend) -> Self {
+        self.backend = backend;
+        self
+    }
+
+    /// Sets [`time_limit`](Self::time_limit): time limit (seconds) of the MILP call.
+    #[must_use]
+    pub fn time_limit(mut self, time_limit: Option<f64>) -> Self {
+        self.time_limit = time_limit;
+        self
     }
 }
 

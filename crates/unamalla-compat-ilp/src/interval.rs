@@ -80,6 +80,7 @@ pub struct IntervalProblem {
 
 /// Options of [`assign_intervals`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct IntervalOptions {
     /// Target element size `h`: `N_e = max(1, round(l(e)/h))` for edges without a prescription.
     pub target_size: f64,
@@ -97,6 +98,20 @@ impl IntervalOptions {
             include_max_term: true,
             backend: MilpBackend::Microlp,
         }
+    }
+
+    /// Sets [`include_max_term`](Self::include_max_term).
+    #[must_use]
+    pub fn include_max_term(mut self, include_max_term: bool) -> Self {
+        self.include_max_term = include_max_term;
+        self
+    }
+
+    /// Sets [`backend`](Self::backend): MILP backend.
+    #[must_use]
+    pub fn backend(mut self, backend: MilpBackend) -> Self {
+        self.backend = backend;
+        self
     }
 }
 

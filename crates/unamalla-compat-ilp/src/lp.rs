@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 /// The MILP backend used through `good_lp`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[non_exhaustive]
 pub enum MilpBackend {
     /// Pure-Rust `microlp` (default; always available).
     #[default]

@@ -13,6 +13,7 @@ use crate::verify::{check, Optimality, Verification};
 /// Which method to try first. Whatever is chosen, every candidate is verified and the other paths are
 /// used as fallbacks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Method {
     /// The MILP of (5.10) in its direct form through `good_lp` (default: `microlp`).
     Milp(MilpBackend),
@@ -29,6 +30,7 @@ impl Default for Method {
 
 /// Options of [`solve()`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SolveOptions {
     /// How the lower bounds are derived (density `d` or target cell size `h`).
     pub bounds: LowerBounds,
@@ -73,6 +75,29 @@ impl SolveOptions {
     /// Builder: choose the first method.
     pub fn with_method(mut self, method: Method) -> Self {
         self.method = method;
+        self
+    }
+
+    /// Sets [`bounds`](Self::bounds): how the lower bounds are derived (density `d` or target cell
+    /// size `h`).
+    #[must_use]
+    pub fn bounds(mut self, bounds: LowerBounds) -> Self {
+        self.bounds = bounds;
+        self
+    }
+
+    /// Sets [`minimize_conflict`](Self::minimize_conflict).
+    #[must_use]
+    pub fn minimize_conflict(mut self, minimize_conflict: bool) -> Self {
+        self.minimize_conflict = minimize_conflict;
+        self
+    }
+
+    /// Sets [`time_limit`](Self::time_limit): time limit in seconds for each MILP call (`None`: no
+    /// limit).
+    #[must_use]
+    pub fn time_limit(mut self, time_limit: Option<f64>) -> Self {
+        self.time_limit = time_limit;
         self
     }
 }

@@ -51,6 +51,7 @@ impl VertexKind {
 
 /// Options of [`classify_vertices`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct VertexClassOptions {
     /// Number of holes `H` (0: ILP (6); ≥ 1: ILP (8), global sum `4(1 − H)`).
     pub holes: usize,
@@ -70,6 +71,37 @@ impl Default for VertexClassOptions {
             omega: None,
             backend: MilpBackend::Microlp,
         }
+    }
+}
+
+impl VertexClassOptions {
+    /// Sets [`holes`](Self::holes): number of holes `H` (0: ILP (6); ≥ 1: ILP (8), global sum
+    /// `4(1 − H)`).
+    #[must_use]
+    pub fn holes(mut self, holes: usize) -> Self {
+        self.holes = holes;
+        self
+    }
+
+    /// Sets [`rho`](Self::rho): weights `ρ_i` of the positive parts (default all 1).
+    #[must_use]
+    pub fn rho(mut self, rho: Option<Vec<f64>>) -> Self {
+        self.rho = rho;
+        self
+    }
+
+    /// Sets [`omega`](Self::omega): weights `ω_i` of the negative parts (default all 1).
+    #[must_use]
+    pub fn omega(mut self, omega: Option<Vec<f64>>) -> Self {
+        self.omega = omega;
+        self
+    }
+
+    /// Sets [`backend`](Self::backend): MILP backend.
+    #[must_use]
+    pub fn backend(mut self, backend: MilpBackend) -> Self {
+        self.backend = backend;
+        self
     }
 }
 

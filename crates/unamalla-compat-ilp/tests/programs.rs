@@ -173,14 +173,8 @@ fn interval_assignment_adds_on_the_longer_edge() {
     let expected = 1.0 + 2.0 / 1.2 + 1.0 + 3.0 / 2.6 + 1.0 + 2.0;
     assert!((sol.objective - expected).abs() < 1e-9);
     // f_1 (no M term) picks the same counts here
-    let f1 = assign_intervals(
-        &problem,
-        &IntervalOptions {
-            include_max_term: false,
-            ..IntervalOptions::new(1.0)
-        },
-    )
-    .unwrap();
+    let f1 =
+        assign_intervals(&problem, &IntervalOptions::new(1.0).include_max_term(false)).unwrap();
     assert_eq!(f1.intervals, vec![1, 2, 1, 3, 1]);
 }
 
@@ -210,14 +204,8 @@ fn interval_objectives_f1_and_f2_disagree() {
     assert_eq!(f2.intervals, vec![4, 1, 2, 2, 1]);
     assert!((f2.max_ratio - 2.0).abs() < 1e-12);
     assert!((f2.objective - 8.0).abs() < 1e-9, "{}", f2.objective);
-    let f1 = assign_intervals(
-        &problem,
-        &IntervalOptions {
-            include_max_term: false,
-            ..IntervalOptions::new(1.0)
-        },
-    )
-    .unwrap();
+    let f1 =
+        assign_intervals(&problem, &IntervalOptions::new(1.0).include_max_term(false)).unwrap();
     assert_eq!(f1.intervals, vec![4, 1, 1, 3, 1]);
     assert!((f1.objective - 5.5).abs() < 1e-9, "{}", f1.objective);
     assert!((f1.max_ratio - 3.0).abs() < 1e-12);
@@ -296,10 +284,7 @@ fn vertex_classification_with_a_hole_t9() {
     // the hole gets 4 Corners and 2 Sides, cost 8/3.
     let mut alpha = vec![1.0; 4];
     alpha.extend([-2.0 / 3.0; 6]);
-    let opts = VertexClassOptions {
-        holes: 1,
-        ..Default::default()
-    };
+    let opts = VertexClassOptions::default().holes(1);
     let c = classify_vertices(&alpha, &opts).unwrap();
     assert_eq!(&c.labels[..4], &[1, 1, 1, 1]);
     assert_eq!(c.labels[4..].iter().filter(|&&a| a == -1).count(), 4);

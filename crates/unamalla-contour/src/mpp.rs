@@ -28,6 +28,7 @@ use crate::error::ContourError;
 
 /// Tuning of the MPP solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct MppOptions {
     /// Stopping tolerance on the projected-gradient step, in units of the box half-width.
     pub tol: f64,
@@ -44,6 +45,29 @@ impl Default for MppOptions {
             max_iter: 1000,
             levels: 3,
         }
+    }
+}
+
+impl MppOptions {
+    /// Sets [`tol`](Self::tol).
+    #[must_use]
+    pub fn tol(mut self, tol: f64) -> Self {
+        self.tol = tol;
+        self
+    }
+
+    /// Sets [`max_iter`](Self::max_iter): maximum SPG iterations per smoothing level.
+    #[must_use]
+    pub fn max_iter(mut self, max_iter: usize) -> Self {
+        self.max_iter = max_iter;
+        self
+    }
+
+    /// Sets [`levels`](Self::levels): number of smoothing levels: η = h·10^(−k), k = 0..levels.
+    #[must_use]
+    pub fn levels(mut self, levels: usize) -> Self {
+        self.levels = levels;
+        self
     }
 }
 

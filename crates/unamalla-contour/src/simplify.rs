@@ -38,6 +38,7 @@ use crate::removal::{batch, sequential, Stop, Workspace};
 /// their first step always uses the thesis's fixed value (1e-4, resp. 0.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
 pub enum Method {
     /// Scaled Visvalingam (§3.1.1, Obs 3.1): repeatedly remove the vertex of smallest triangle
     /// area while that area is below `ε · ā`, `ā` the mean triangle area of the input ring
@@ -160,6 +161,7 @@ impl FromStr for Method {
 /// Which set of default thresholds to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
 pub enum Preset {
     /// No noise: simplification thresholds (e.g. modified three-step δ = 1e-5, ε = 0.1).
     #[default]
@@ -173,6 +175,7 @@ pub enum Preset {
 /// Which holes to drop before simplifying (the thesis recommends removing negligible holes
 /// before meshing, Obs A.1).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum HoleFilter {
     /// Keep every hole.
     #[default]
@@ -198,6 +201,7 @@ pub fn hole_width(hole: &unamalla_mesh::Polygon) -> f64 {
 /// Options of [`simplify_region`]. `Default` is modified areas with the clean preset (ε = 1),
 /// all holes kept.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct SimplifyOptions {
     /// The method.
     pub method: Method,
@@ -221,6 +225,48 @@ impl SimplifyOptions {
             preset,
             ..Self::default()
         }
+    }
+
+    /// Sets [`method`](Self::method): the method.
+    #[must_use]
+    pub fn method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// Sets [`preset`](Self::preset): which defaults to use when `epsilon` / `delta` are not given.
+    #[must_use]
+    pub fn preset(mut self, preset: Preset) -> Self {
+        self.preset = preset;
+        self
+    }
+
+    /// Sets [`epsilon`](Self::epsilon): threshold ε (overrides the preset's).
+    #[must_use]
+    pub fn epsilon(mut self, epsilon: Option<f64>) -> Self {
+        self.epsilon = epsilon;
+        self
+    }
+
+    /// Sets [`delta`](Self::delta).
+    #[must_use]
+    pub fn delta(mut self, delta: Option<f64>) -> Self {
+        self.delta = delta;
+        self
+    }
+
+    /// Sets [`holes`](Self::holes): hole dropping.
+    #[must_use]
+    pub fn holes(mut self, holes: HoleFilter) -> Self {
+        self.holes = holes;
+        self
+    }
+
+    /// Sets [`mpp`](Self::mpp): MPP solver tuning.
+    #[must_use]
+    pub fn mpp(mut self, mpp: MppOptions) -> Self {
+        self.mpp = mpp;
+        self
     }
 }
 

@@ -24,10 +24,7 @@ use unamalla_contour::{detect_noise_region, simplify_region, Method, Preset, Sim
 use unamalla_mesh::Region;
 
 fn removed(region: &Region, method: Method, eps: f64) -> usize {
-    let opts = SimplifyOptions {
-        epsilon: Some(eps),
-        ..SimplifyOptions::new(method, Preset::Clean)
-    };
+    let opts = SimplifyOptions::new(method, Preset::Clean).epsilon(Some(eps));
     let r = simplify_region(region, &opts).expect("simplify");
     r.vertices_before - r.vertices_after
 }

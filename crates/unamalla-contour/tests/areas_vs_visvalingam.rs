@@ -10,10 +10,7 @@ use unamalla_mesh::{DVec2, Region};
 
 fn removed(ring: Vec<DVec2>, method: Method, eps: f64) -> usize {
     let region = Region::new(ring, vec![]).unwrap();
-    let opts = SimplifyOptions {
-        epsilon: Some(eps),
-        ..SimplifyOptions::new(method, Preset::Clean)
-    };
+    let opts = SimplifyOptions::new(method, Preset::Clean).epsilon(Some(eps));
     let r = simplify_region(&region, &opts).unwrap();
     r.vertices_before - r.vertices_after
 }

@@ -28,6 +28,7 @@ use crate::CoreError;
 
 /// Options of [`block_maps`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct BlockMapOptions {
     /// Samples per direction of the dense `det J` sample of each map.
     pub samples: usize,
@@ -44,6 +45,30 @@ impl Default for BlockMapOptions {
             subdivision: 4,
             biquadratic: true,
         }
+    }
+}
+
+impl BlockMapOptions {
+    /// Sets [`samples`](Self::samples): samples per direction of the dense `det J` sample of each
+    /// map.
+    #[must_use]
+    pub fn samples(mut self, samples: usize) -> Self {
+        self.samples = samples;
+        self
+    }
+
+    /// Sets [`subdivision`](Self::subdivision): maximum subdivision depth of the Bernstein test.
+    #[must_use]
+    pub fn subdivision(mut self, subdivision: usize) -> Self {
+        self.subdivision = subdivision;
+        self
+    }
+
+    /// Sets [`biquadratic`](Self::biquadratic): also build and certify the biquadratic maps.
+    #[must_use]
+    pub fn biquadratic(mut self, biquadratic: bool) -> Self {
+        self.biquadratic = biquadratic;
+        self
     }
 }
 

@@ -311,10 +311,7 @@ pub fn coarse_options(opts: &SmoothOptions) -> SmoothOptions {
 /// nested iteration leaves only the fine-scale error, which Newton removes in a few
 /// iterations).
 pub fn polish_options(opts: &SmoothOptions) -> SmoothOptions {
-    let mut o = SmoothOptions {
-        sigma_continuation: Vec::new(),
-        ..opts.clone()
-    };
+    let mut o = opts.clone().sigma_continuation(Vec::new());
     o.solver.stop = o.solver.stop.polish();
     o
 }

@@ -45,6 +45,7 @@ pub const LISTED_CELLS: usize = 5;
 
 /// Tolerances of [`verify_quads`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct VerifyOptions {
     /// Largest accepted relative area defect `|A_mesh − A_Ω| / A_Ω`.
     pub area_tolerance: f64,
@@ -58,6 +59,16 @@ impl Default for VerifyOptions {
         Self {
             area_tolerance: 0.02,
         }
+    }
+}
+
+impl VerifyOptions {
+    /// Sets [`area_tolerance`](Self::area_tolerance): largest accepted relative area defect
+    /// `|A_mesh − A_Ω| / A_Ω`.
+    #[must_use]
+    pub fn area_tolerance(mut self, area_tolerance: f64) -> Self {
+        self.area_tolerance = area_tolerance;
+        self
     }
 }
 

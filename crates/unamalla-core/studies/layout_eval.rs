@@ -46,10 +46,7 @@ fn main() {
                 continue;
             }
         };
-        let opts = DecomposeOptions {
-            chord_aspect: aspect,
-            ..DecomposeOptions::default()
-        };
+        let opts = DecomposeOptions::default().chord_aspect(aspect);
         let t = std::time::Instant::now();
         if predict_only {
             let mesher = Mesher::new().cells(cells).decompose_options(opts.clone());
@@ -58,10 +55,7 @@ fn main() {
             };
             let r = &prep.mesh_region;
             let h = (r.area() / cells as f64).sqrt();
-            let o = DecomposeOptions {
-                cell_size: Some(h),
-                ..opts
-            };
+            let o = opts.cell_size(Some(h));
             match unamalla_core::pipeline::choose_layout(
                 r,
                 &o,

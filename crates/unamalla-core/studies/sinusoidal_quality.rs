@@ -90,10 +90,7 @@ fn main() {
         let r = match mode {
             "default" => smooth(&mut g, &o, &mut trace).expect("smooth"),
             "c2f" | "reference" => {
-                let co = CoarseToFineOptions {
-                    smooth: o,
-                    ..CoarseToFineOptions::default()
-                };
+                let co = CoarseToFineOptions::default().smooth(o);
                 let rep = smooth_coarse_to_fine(&mut g, &co, &mut trace).expect("c2f");
                 for l in &rep.levels {
                     eprintln!(

@@ -37,17 +37,11 @@ fn fixture(name: &str) -> std::path::PathBuf {
 }
 
 fn options(region: &Region, cells: usize) -> DecomposeOptions {
-    DecomposeOptions {
-        cell_size: Some((region.area() / cells as f64).sqrt()),
-        ..DecomposeOptions::default()
-    }
+    DecomposeOptions::default().cell_size(Some((region.area() / cells as f64).sqrt()))
 }
 
 fn concavity(region: &Region, cells: usize) -> Result<Decomposition, String> {
-    let opts = DecomposeOptions {
-        layout: Layout::Concavity,
-        ..options(region, cells)
-    };
+    let opts = options(region, cells).layout(Layout::Concavity);
     decompose(region, &opts).map_err(|e| e.to_string())
 }
 

@@ -58,10 +58,8 @@ fn a_layout_that_leaves_folds_is_replaced_by_the_next_candidate() {
 #[test]
 fn excluded_layouts_are_not_chosen() {
     let reg = region("crete");
-    let opts = unamalla_core::decompose::DecomposeOptions {
-        cell_size: Some((reg.area() / 2_000.0).sqrt()),
-        ..Default::default()
-    };
+    let opts = unamalla_core::decompose::DecomposeOptions::default()
+        .cell_size(Some((reg.area() / 2_000.0).sqrt()));
     let size = unamalla_core::pipeline::MeshSize::Cells(2_000);
     let (_, first) = choose_layout_excluding(&reg, &opts, size, &[]).unwrap();
     let (_, second) =

@@ -46,6 +46,7 @@ impl Default for CutWeights {
 
 /// Options of [`decompose`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct DecomposeOptions {
     /// Concavity tolerances and the critical angle θ₋.
     pub tolerances: Tolerances,
@@ -99,6 +100,7 @@ pub struct DecomposeOptions {
 
 /// How the first cuts of a decomposition are placed (crate docs, "Layouts").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Layout {
     /// The thesis's Algorithm 1 alone: hole removal (Algorithm 2) and concavity cuts
     /// (Algorithm 3) from the deepest reflex vertices.
@@ -130,6 +132,115 @@ impl Default for DecomposeOptions {
             chord_aspect: crate::chords::DEFAULT_ASPECT,
             cell_size: None,
         }
+    }
+}
+
+impl DecomposeOptions {
+    /// Sets [`tolerances`](Self::tolerances): concavity tolerances and the critical angle θ₋.
+    #[must_use]
+    pub fn tolerances(mut self, tolerances: Tolerances) -> Self {
+        self.tolerances = tolerances;
+        self
+    }
+
+    /// Sets [`min_area_fraction`](Self::min_area_fraction).
+    #[must_use]
+    pub fn min_area_fraction(mut self, min_area_fraction: f64) -> Self {
+        self.min_area_fraction = min_area_fraction;
+        self
+    }
+
+    /// Sets [`max_blocks`](Self::max_blocks): stop splitting when this many blocks exist (default
+    /// 400).
+    #[must_use]
+    pub fn max_blocks(mut self, max_blocks: usize) -> Self {
+        self.max_blocks = max_blocks;
+        self
+    }
+
+    /// Sets [`concave_starts`](Self::concave_starts).
+    #[must_use]
+    pub fn concave_starts(mut self, concave_starts: usize) -> Self {
+        self.concave_starts = concave_starts;
+        self
+    }
+
+    /// Sets [`cut_weights`](Self::cut_weights): cut score weights.
+    #[must_use]
+    pub fn cut_weights(mut self, cut_weights: CutWeights) -> Self {
+        self.cut_weights = cut_weights;
+        self
+    }
+
+    /// Sets [`corner_weights`](Self::corner_weights): corner score weights.
+    #[must_use]
+    pub fn corner_weights(mut self, corner_weights: CornerWeights) -> Self {
+        self.corner_weights = corner_weights;
+        self
+    }
+
+    /// Sets [`critical_triangles`](Self::critical_triangles).
+    #[must_use]
+    pub fn critical_triangles(mut self, critical_triangles: bool) -> Self {
+        self.critical_triangles = critical_triangles;
+        self
+    }
+
+    /// Sets [`merge_blocks`](Self::merge_blocks).
+    #[must_use]
+    pub fn merge_blocks(mut self, merge_blocks: bool) -> Self {
+        self.merge_blocks = merge_blocks;
+        self
+    }
+
+    /// Sets [`triangle_insert_fraction`](Self::triangle_insert_fraction).
+    #[must_use]
+    pub fn triangle_insert_fraction(mut self, triangle_insert_fraction: f64) -> Self {
+        self.triangle_insert_fraction = triangle_insert_fraction;
+        self
+    }
+
+    /// Sets [`min_triangle_fraction`](Self::min_triangle_fraction).
+    #[must_use]
+    pub fn min_triangle_fraction(mut self, min_triangle_fraction: f64) -> Self {
+        self.min_triangle_fraction = min_triangle_fraction;
+        self
+    }
+
+    /// Sets [`repair_corners`](Self::repair_corners).
+    #[must_use]
+    pub fn repair_corners(mut self, repair_corners: bool) -> Self {
+        self.repair_corners = repair_corners;
+        self
+    }
+
+    /// Sets [`edge_point_cuts`](Self::edge_point_cuts).
+    #[must_use]
+    pub fn edge_point_cuts(mut self, edge_point_cuts: bool) -> Self {
+        self.edge_point_cuts = edge_point_cuts;
+        self
+    }
+
+    /// Sets [`layout`](Self::layout): which layout places the first cuts (default
+    /// [`Layout::Chords`]).
+    #[must_use]
+    pub fn layout(mut self, layout: Layout) -> Self {
+        self.layout = layout;
+        self
+    }
+
+    /// Sets [`chord_aspect`](Self::chord_aspect).
+    #[must_use]
+    pub fn chord_aspect(mut self, chord_aspect: f64) -> Self {
+        self.chord_aspect = chord_aspect;
+        self
+    }
+
+    /// Sets [`cell_size`](Self::cell_size).
+    #[must_use]
+    pub fn cell_size(mut self, cell_size: Option<f64>) -> Self {
+        self.cell_size = cell_size;
+        self
     }
 }
 

@@ -31,6 +31,7 @@ use crate::geom::{angle_penalty, ring_angle};
 
 /// How [`select_corners`] chooses the four corners of a block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum CornerChoice {
     /// Exhaustive search of the corner score F over the best candidates (module
     /// [`crate::corners`]).

@@ -3,6 +3,7 @@
 /// Why a decomposition could not be computed, loaded or validated. Every variant names the
 /// offending block, cut, ring or vertex.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum DecomposeError {
     /// No admissible pair of cuts removes this hole of a piece (hole numbers are region hole
     /// numbers, 0-based).

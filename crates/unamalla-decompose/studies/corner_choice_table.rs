@@ -113,13 +113,7 @@ fn main() {
         tot[4] += is;
         tot[5] += id;
         let t1 = Instant::now();
-        let dd = decompose(
-            &region,
-            &DecomposeOptions {
-                corner_weights: diam,
-                ..DecomposeOptions::default()
-            },
-        );
+        let dd = decompose(&region, &DecomposeOptions::default().corner_weights(diam));
         let t_d = t1.elapsed().as_secs_f64();
         let wide = |d: &unamalla_decompose::Decomposition| {
             d.blocks

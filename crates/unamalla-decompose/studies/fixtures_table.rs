@@ -59,10 +59,7 @@ fn main() {
         .filter(|p| p.extension().is_some_and(|x| x == "geojson"))
         .collect();
     files.sort();
-    let opts = DecomposeOptions {
-        merge_blocks: merge,
-        ..DecomposeOptions::default()
-    };
+    let opts = DecomposeOptions::default().merge_blocks(merge);
     let tol = Tolerances::default();
     println!("| region | vertices (raw → simplified) | holes (handled) | blocks | triangles | cuts | admissible blocks | convex blocks | min / max corner angle (quad blocks) | corners ≥ 170° | cut joints | time |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");

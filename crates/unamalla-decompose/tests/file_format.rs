@@ -114,10 +114,7 @@ fn corner_overrides_and_corner_errors() {
     .unwrap();
     // the thesis's layout keeps the 4 × 1 strip as one block (the chord layout cuts it across
     // in two 2 × 1 blocks: its middle chord scores 2/1² ≥ T = 1.5)
-    let opts = DecomposeOptions {
-        layout: unamalla_decompose::Layout::Concavity,
-        ..DecomposeOptions::default()
-    };
+    let opts = DecomposeOptions::default().layout(unamalla_decompose::Layout::Concavity);
     let d = decompose(&r, &opts).unwrap();
     assert_eq!(d.blocks.len(), 1);
     let mut c = d.blocks[0].corners;

@@ -69,10 +69,7 @@ fn pipeline_regions_meet_the_corner_rules() {
         // block admissible (the mesher's layout choice prefers admissible layouts)
         let mut fully = Vec::new();
         for layout in [Layout::Concavity, Layout::Chords] {
-            let opts = DecomposeOptions {
-                layout,
-                ..DecomposeOptions::default()
-            };
+            let opts = DecomposeOptions::default().layout(layout);
             let d = decompose(&region, &opts)
                 .unwrap_or_else(|e| panic!("{} {layout:?}: {e}", f.display()));
             d.validate(&region).unwrap();

@@ -7,10 +7,7 @@ use unamalla_mesh::{DVec2, Region};
 /// The thesis's layout (Algorithm 1 alone): these known answers are the thesis's
 /// (the chord layout, the default, may cut a triangle or a strip across first).
 fn thesis() -> DecomposeOptions {
-    DecomposeOptions {
-        layout: unamalla_decompose::Layout::Concavity,
-        ..DecomposeOptions::default()
-    }
+    DecomposeOptions::default().layout(unamalla_decompose::Layout::Concavity)
 }
 
 fn v(x: f64, y: f64) -> DVec2 {

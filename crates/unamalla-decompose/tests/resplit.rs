@@ -16,10 +16,7 @@ fn rect(w: f64, h: f64) -> Region {
 }
 
 fn concavity() -> DecomposeOptions {
-    DecomposeOptions {
-        layout: Layout::Concavity,
-        ..DecomposeOptions::default()
-    }
+    DecomposeOptions::default().layout(Layout::Concavity)
 }
 
 /// A 3 × 1 rectangle is one block. Its best chord is the transverse one at x = 1.5: a chord

@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Everything a user's input (mesh, parameters, functional names) can get wrong.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum FunctionalError {
     /// A functional name given to [`FunctionalSpec::from_name`](crate::FunctionalSpec::from_name)
     /// is not known.

@@ -21,6 +21,7 @@ use crate::csr::Csr;
 
 /// Errors of the conversions.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CsrConversionError {
     /// The arrays of a [`Csr`] do not form a valid CSR matrix (a `Csr`'s fields are public, so
     /// a caller can break its invariants).

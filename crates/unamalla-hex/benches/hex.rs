@@ -43,10 +43,7 @@ fn bench_algorithm_a(c: &mut Criterion) {
     group.warm_up_time(Duration::from_millis(500));
     group.measurement_time(Duration::from_secs(6));
     let start = sphere(20);
-    let opts = HexRunOptions {
-        algorithm: HexAlgorithm::A,
-        ..HexRunOptions::default()
-    };
+    let opts = HexRunOptions::default().algorithm(HexAlgorithm::A);
     group.bench_function("sphere20", |b| {
         b.iter_batched(
             || start.clone(),

@@ -23,6 +23,7 @@ use crate::{HexError, HexRunReport};
 /// How the start is perturbed ([`perturb_interior`]: each free node moves by
 /// `s·h_v·u`, `h_v` its shortest edge, `u` uniform in the unit ball).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Perturbation {
     /// No perturbation.
     None,
@@ -56,6 +57,7 @@ impl Perturbation {
 
 /// Which algorithms to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum HexAlgorithm {
     /// Algorithm A only.
     A,
@@ -68,6 +70,7 @@ pub enum HexAlgorithm {
 /// but its reported values fit only unit-parametric Jacobians (our reading; see
 /// `unamalla_functionals::hex`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum HexScaling {
     /// Raw vertex differences, as printed in the thesis.
     Index,
@@ -76,8 +79,30 @@ pub enum HexScaling {
     Parametric,
 }
 
-/// Options of [`run_hex`].
+/// Options of [`run_hex`]. Build them from [`HexRunOptions::default`] and the setters (or
+/// assign the fields of a default value); new options may be added in minor releases.
+///
+/// ```
+/// use unamalla_hex::{HexAlgorithm, HexRunOptions, HexScaling};
+///
+/// let mut opts = HexRunOptions::default()
+///     .algorithm(HexAlgorithm::A)
+///     .scaling(HexScaling::Index)
+///     .planarity_tol(0.05)
+///     .planarity_volume_tol(1e-5)
+///     .histogram_bins(10);
+/// opts.omega.solver.max_iter = 20;
+/// assert_eq!(opts.algorithm, HexAlgorithm::A);
+/// assert_eq!(opts.scaling, HexScaling::Index);
+/// assert_eq!((opts.planarity_tol, opts.planarity_volume_tol), (0.05, 1e-5));
+/// assert_eq!((opts.histogram_bins, opts.omega.solver.max_iter), (10, 20));
+/// let defaults = HexRunOptions::default();
+/// assert_eq!(opts.coplanarity, defaults.coplanarity);
+/// let opts = opts.omega(defaults.omega.clone()).coplanarity(defaults.coplanarity.clone());
+/// assert_eq!(opts.omega, defaults.omega);
+/// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct HexRunOptions {
     /// A or A + B.
     pub algorithm: HexAlgorithm,
@@ -103,35 +128,73 @@ pub struct HexRunOptions {
 
 impl Default for HexRunOptions {
     fn default() -> Self {
-        let solver = SolverOptions {
-            max_iter: 100,
-            ftol: 1e-8,
-            gtol: 1e-4,
-            ..SolverOptions::default()
-        };
+        let solver = SolverOptions::default().max_iter(100).ftol(1e-8).gtol(1e-4);
         Self {
             algorithm: HexAlgorithm::AB,
             scaling: HexScaling::Parametric,
-            omega: OmegaOptions {
-                eps: 1e-4,
+            omega: OmegaOptions::default()
+                .eps(1e-4)
                 // ω₀ = 0.1·(mean tetrahedron Jacobian): on the perturbed sphere 20³ this took
                 // 11 iterations and left 1892 non-hexahedral interior cells, against 14 and
                 // 2216 with ω₀ = v̄ (measured; docs/results.md)
-                omega0_rel: 0.1,
-                solver: solver.clone(),
-                ..OmegaOptions::default()
-            },
-            coplanarity: CoplanarityOptions {
-                solver: SolverOptions {
-                    max_iter: 50,
-                    ..solver
-                },
-                ..CoplanarityOptions::default()
-            },
+                .omega0_rel(0.1)
+                .solver(solver.clone()),
+            coplanarity: CoplanarityOptions::default().solver(solver.max_iter(50)),
             planarity_tol: 1e-2,
             planarity_volume_tol: default_volume_tol(),
             histogram_bins: 20,
         }
+    }
+}
+
+impl HexRunOptions {
+    /// Sets [`algorithm`](Self::algorithm): A or A + B.
+    #[must_use]
+    pub fn algorithm(mut self, algorithm: HexAlgorithm) -> Self {
+        self.algorithm = algorithm;
+        self
+    }
+
+    /// Sets [`scaling`](Self::scaling): Jacobian scaling of `H_ω`.
+    #[must_use]
+    pub fn scaling(mut self, scaling: HexScaling) -> Self {
+        self.scaling = scaling;
+        self
+    }
+
+    /// Sets [`omega`](Self::omega).
+    #[must_use]
+    pub fn omega(mut self, omega: OmegaOptions) -> Self {
+        self.omega = omega;
+        self
+    }
+
+    /// Sets [`coplanarity`](Self::coplanarity).
+    #[must_use]
+    pub fn coplanarity(mut self, coplanarity: CoplanarityOptions) -> Self {
+        self.coplanarity = coplanarity;
+        self
+    }
+
+    /// Sets [`planarity_tol`](Self::planarity_tol).
+    #[must_use]
+    pub fn planarity_tol(mut self, planarity_tol: f64) -> Self {
+        self.planarity_tol = planarity_tol;
+        self
+    }
+
+    /// Sets [`planarity_volume_tol`](Self::planarity_volume_tol).
+    #[must_use]
+    pub fn planarity_volume_tol(mut self, planarity_volume_tol: f64) -> Self {
+        self.planarity_volume_tol = planarity_volume_tol;
+        self
+    }
+
+    /// Sets [`histogram_bins`](Self::histogram_bins): bins of the edge-length histogram.
+    #[must_use]
+    pub fn histogram_bins(mut self, histogram_bins: usize) -> Self {
+        self.histogram_bins = histogram_bins;
+        self
     }
 }
 
@@ -362,10 +425,7 @@ mod tests {
                 .apply(&mut g, 1)
                 .unwrap();
             let mut o = HexRunOptions::default();
-            o.coplanarity = CoplanarityOptions {
-                solver: o.coplanarity.solver.clone(),
-                ..co
-            };
+            o.coplanarity = co.solver(o.coplanarity.solver.clone());
             run_hex(&mut g, &o, &mut NullObserver).unwrap()
         };
         let d = run(HexRunOptions::default().coplanarity);

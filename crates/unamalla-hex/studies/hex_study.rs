@@ -195,10 +195,7 @@ fn a_time(case: HexCase, runs: usize) {
         case.default_perturbation(dims)
             .apply(&mut g, 1)
             .expect("perturbation");
-        let opts = HexRunOptions {
-            algorithm: HexAlgorithm::A,
-            ..HexRunOptions::default()
-        };
+        let opts = HexRunOptions::default().algorithm(HexAlgorithm::A);
         let r = run_hex(&mut g, &opts, &mut NullObserver).expect("run");
         let st = r.algorithm_a.expect("A ran");
         best = best.min(st.seconds);
@@ -389,10 +386,7 @@ fn b_trace(case: HexCase, dims: Option<(usize, usize, usize)>, o: &BTrace) {
     case.default_perturbation(dims)
         .apply(&mut g, 1)
         .expect("perturbation");
-    let opts = HexRunOptions {
-        algorithm: HexAlgorithm::A,
-        ..HexRunOptions::default()
-    };
+    let opts = HexRunOptions::default().algorithm(HexAlgorithm::A);
     let r = run_hex(&mut g, &opts, &mut NullObserver).expect("A");
     let scaling = Scaling3::Parametric {
         m: dims.0,
@@ -409,14 +403,12 @@ fn b_trace(case: HexCase, dims: Option<(usize, usize, usize)>, o: &BTrace) {
     session.set_phase(Phase::Homotopic);
     session.monitor.omega = Some(omega);
     let mut p = HexFunctional::h_omega(topo.clone(), omega, scaling).expect("functional");
-    let solver = SolverOptions {
-        max_iter: o.iters,
-        ftol: 1e-8,
-        gtol: 1e-4,
-        preconditioner: o.pre,
-        cg_max_iter: o.cg_max,
-        ..SolverOptions::default()
-    };
+    let solver = SolverOptions::default()
+        .max_iter(o.iters)
+        .ftol(1e-8)
+        .gtol(1e-4)
+        .preconditioner(o.pre)
+        .cg_max_iter(o.cg_max);
     println!(
         "{} {}x{}x{}: A {} it, NH after A {}; B μ₀ {:e} ×{} ≤{} it/step, {:?}, cg_max {}",
         case.name(),
@@ -527,10 +519,7 @@ fn energy(name: &str) {
         "{name} {}x{}x{}: unperturbed E (printed) {:.5}; perturbed (amp {amp:.3}, {nc0} non-convex): H_200 parametric {:.7}, index {:.3e}",
         dims.0, dims.1, dims.2, e0.printed, h200(par), h200(Scaling3::Index)
     );
-    let opts = HexRunOptions {
-        algorithm: HexAlgorithm::A,
-        ..HexRunOptions::default()
-    };
+    let opts = HexRunOptions::default().algorithm(HexAlgorithm::A);
     let r = run_hex(&mut g, &opts, &mut NullObserver).expect("run");
     let a = r.algorithm_a.expect("A ran");
     let e = energy_variants(&cells(&g), par).expect("energy");
@@ -563,10 +552,7 @@ fn energy(name: &str) {
     session.guard_threshold = opts.omega.eps * vbar;
     let w = 1e-8 * vbar;
     let hf = HexFunctional::h_omega(topo.clone(), w, par).expect("H");
-    let solver = SolverOptions {
-        max_iter: 500,
-        ..opts.omega.solver.clone()
-    };
+    let solver = opts.omega.solver.clone().max_iter(500);
     let rr = minimize_with(&hf, &mut x, &solver, &mut session, None).expect("minimize");
     let mut g2 = g.clone();
     topo.scatter(&x, unamalla_mesh::HasNodes::nodes_mut(&mut g2));

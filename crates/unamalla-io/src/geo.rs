@@ -38,6 +38,7 @@ use crate::error::IoError;
 
 /// How the input's coordinates are to be read.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum CrsChoice {
     /// Decide from the file (see the module docs).
     #[default]

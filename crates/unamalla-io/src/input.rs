@@ -27,11 +27,28 @@ use crate::patches::BoundaryNames;
 
 /// How to read a region file.
 #[derive(Debug, Clone, Default)]
+#[non_exhaustive]
 pub struct LoadOptions {
     /// `KEY=VALUE` feature selector (see the module docs).
     pub feature: Option<String>,
     /// Coordinate system choice.
     pub crs: CrsChoice,
+}
+
+impl LoadOptions {
+    /// Sets [`feature`](Self::feature): `KEY=VALUE` feature selector (see the module docs).
+    #[must_use]
+    pub fn feature(mut self, feature: Option<String>) -> Self {
+        self.feature = feature;
+        self
+    }
+
+    /// Sets [`crs`](Self::crs): coordinate system choice.
+    #[must_use]
+    pub fn crs(mut self, crs: CrsChoice) -> Self {
+        self.crs = crs;
+        self
+    }
 }
 
 /// A region read by [`load_region`], in the coordinates the mesher works in.

@@ -21,16 +21,13 @@ use unamalla_optim::{
 };
 
 fn options(s: Solver) -> SmoothOptions {
-    SmoothOptions {
-        solver: SolverOptions {
-            max_iter: 500,
-            ftol: 1e-9,
-            gtol: 0.0,
-            preconditioner: Preconditioner::Multigrid,
-            ..SolverOptions::new(s)
-        },
-        ..SmoothOptions::default()
-    }
+    SmoothOptions::default().solver(
+        SolverOptions::new(s)
+            .max_iter(500)
+            .ftol(1e-9)
+            .gtol(0.0)
+            .preconditioner(Preconditioner::Multigrid),
+    )
 }
 
 fn bench(c: &mut Criterion) {
@@ -60,10 +57,7 @@ fn bench(c: &mut Criterion) {
     }
     for n in sizes {
         let g0 = sinusoidal(n, n, 0.1, 2.0).expect("region");
-        let co = CoarseToFineOptions {
-            smooth: options(Solver::TnTr),
-            ..CoarseToFineOptions::default()
-        };
+        let co = CoarseToFineOptions::default().smooth(options(Solver::TnTr));
         group.bench_with_input(BenchmarkId::new("tn-tr-multigrid", n), &n, |b, _| {
             b.iter(|| {
                 let mut g = g0.clone();

@@ -70,6 +70,7 @@ use crate::monitor::{NullObserver, Session};
 
 /// Errors of the adapter (returned to argmin as its `Error`, which wraps any `std::error::Error`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ArgminAdapterError {
     /// A parameter vector of the wrong length was passed.
     #[error("the parameter vector has {got} entries, the problem has {expected} variables")]

@@ -44,6 +44,7 @@ use crate::monitor::Observer;
 
 /// Options of [`smooth_coarse_to_fine`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct CoarseToFineOptions {
     /// The smoothing of every level (functional, ε, solver); the finest level uses these
     /// solver tolerances (with [`crate::StopRules::polish`] when it starts from a prolongation).
@@ -65,6 +66,37 @@ impl Default for CoarseToFineOptions {
             min_nodes: 30,
             coarse_ftol: 1e-6,
         }
+    }
+}
+
+impl CoarseToFineOptions {
+    /// Sets [`smooth`](Self::smooth).
+    #[must_use]
+    pub fn smooth(mut self, smooth: SmoothOptions) -> Self {
+        self.smooth = smooth;
+        self
+    }
+
+    /// Sets [`ratio`](Self::ratio).
+    #[must_use]
+    pub fn ratio(mut self, ratio: usize) -> Self {
+        self.ratio = ratio;
+        self
+    }
+
+    /// Sets [`min_nodes`](Self::min_nodes): minimum nodes per side of the coarsest level.
+    #[must_use]
+    pub fn min_nodes(mut self, min_nodes: usize) -> Self {
+        self.min_nodes = min_nodes;
+        self
+    }
+
+    /// Sets [`coarse_ftol`](Self::coarse_ftol): FTOL of the coarse levels (they only provide a
+    /// start).
+    #[must_use]
+    pub fn coarse_ftol(mut self, coarse_ftol: f64) -> Self {
+        self.coarse_ftol = coarse_ftol;
+        self
     }
 }
 
@@ -222,7 +254,7 @@ pub fn prolongate(
 ///
 /// // 28 nodes per side: one coarse level of (28 − 1)/3 + 1 = 10 nodes
 /// let mut grid = sinusoidal(28, 28, 0.1, 2.0)?;
-/// let opts = CoarseToFineOptions { min_nodes: 8, ..CoarseToFineOptions::default() };
+/// let opts = CoarseToFineOptions::default().min_nodes(8);
 /// let rep = smooth_coarse_to_fine(&mut grid, &opts, &mut NullObserver)?;
 /// assert_eq!(rep.levels.iter().map(|l| l.m).collect::<Vec<_>>(), vec![10, 28]);
 /// assert!(rep.fine().is_some_and(|r| r.eps_convex));

@@ -6,6 +6,7 @@ use unamalla_mesh::MeshError;
 /// Errors of the optimizers and drivers. Anything a user's input can cause is reported here;
 /// a run that merely fails to converge is not an error but a [`Status`](crate::Status).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum OptimError {
     /// Building or re-parametrizing a functional failed (e.g. non-finite node coordinates).
     #[error("functional: {0}")]

@@ -87,6 +87,7 @@ pub fn scale_add(a: f64, y: &mut [f64], x: &[f64]) {
 
 /// The preconditioner of the inner CG of truncated Newton.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum Preconditioner {
     /// None (plain CG, as argmin's `NewtonCG`).
     None,

@@ -12,6 +12,7 @@ use crate::status::LineSearchFailure;
 
 /// Parameters of the Moré–Thuente search.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct LineSearchParams {
     /// Sufficient-decrease constant `μ` (Armijo).
     pub ftol: f64,
@@ -37,6 +38,50 @@ impl Default for LineSearchParams {
             stpmax: 1e20,
             maxfev: 20,
         }
+    }
+}
+
+impl LineSearchParams {
+    /// Sets [`ftol`](Self::ftol): sufficient-decrease constant `μ` (Armijo).
+    #[must_use]
+    pub fn ftol(mut self, ftol: f64) -> Self {
+        self.ftol = ftol;
+        self
+    }
+
+    /// Sets [`gtol`](Self::gtol): curvature constant `η` (strong Wolfe).
+    #[must_use]
+    pub fn gtol(mut self, gtol: f64) -> Self {
+        self.gtol = gtol;
+        self
+    }
+
+    /// Sets [`xtol`](Self::xtol): relative tolerance on the interval of uncertainty.
+    #[must_use]
+    pub fn xtol(mut self, xtol: f64) -> Self {
+        self.xtol = xtol;
+        self
+    }
+
+    /// Sets [`stpmin`](Self::stpmin): smallest step.
+    #[must_use]
+    pub fn stpmin(mut self, stpmin: f64) -> Self {
+        self.stpmin = stpmin;
+        self
+    }
+
+    /// Sets [`stpmax`](Self::stpmax): largest step.
+    #[must_use]
+    pub fn stpmax(mut self, stpmax: f64) -> Self {
+        self.stpmax = stpmax;
+        self
+    }
+
+    /// Sets [`maxfev`](Self::maxfev): maximum number of function evaluations.
+    #[must_use]
+    pub fn maxfev(mut self, maxfev: usize) -> Self {
+        self.maxfev = maxfev;
+        self
     }
 }
 

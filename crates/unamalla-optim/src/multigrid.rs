@@ -49,6 +49,7 @@ use crate::linalg::{PrecondApply, Preconditioner};
 
 /// Options of the multigrid hierarchy.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct MultigridOptions {
     /// Stop coarsening when a level has at most this many unknowns (solved directly).
     pub coarse_size: usize,
@@ -68,6 +69,37 @@ impl Default for MultigridOptions {
             sweeps: 1,
             strength: 0.0,
         }
+    }
+}
+
+impl MultigridOptions {
+    /// Sets [`coarse_size`](Self::coarse_size).
+    #[must_use]
+    pub fn coarse_size(mut self, coarse_size: usize) -> Self {
+        self.coarse_size = coarse_size;
+        self
+    }
+
+    /// Sets [`max_levels`](Self::max_levels): maximum number of levels (including the finest).
+    #[must_use]
+    pub fn max_levels(mut self, max_levels: usize) -> Self {
+        self.max_levels = max_levels;
+        self
+    }
+
+    /// Sets [`sweeps`](Self::sweeps): smoothing sweeps before and after the coarse correction
+    /// (`ν`).
+    #[must_use]
+    pub fn sweeps(mut self, sweeps: usize) -> Self {
+        self.sweeps = sweeps;
+        self
+    }
+
+    /// Sets [`strength`](Self::strength).
+    #[must_use]
+    pub fn strength(mut self, strength: f64) -> Self {
+        self.strength = strength;
+        self
     }
 }
 

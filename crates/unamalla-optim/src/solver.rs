@@ -38,6 +38,7 @@ use crate::status::{LineSearchFailure, StopReason};
 
 /// The optimization method (names as accepted by `unamalla smooth --solver`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum Solver {
     /// `tn-tr`: truncated Newton with a trust region (Steihaug–CG, negative-curvature exit);
     /// UNAMALLA's default and the TRON family of [Méndez 2023, §6.4.2] and
@@ -102,6 +103,7 @@ impl FromStr for Solver {
 
 /// Mode of pointwise Newton (UNAMALLA "Newton Point to Point").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum PointwiseMode {
     /// Solve the local 2×2 (3×3) Newton system.
     #[default]
@@ -137,6 +139,7 @@ impl FromStr for PointwiseMode {
 
 /// How truncated Newton forms Hessian-vector products.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum HessianMode {
     /// Assemble the sparse Hessian once per outer iteration and multiply (fast; memory
     /// `≈ 12 bytes × 18 × 2 × free nodes` in 2D).
@@ -159,6 +162,7 @@ pub enum HessianMode {
 
 /// Options of one solver run.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct SolverOptions {
     /// The method.
     pub solver: Solver,
@@ -366,6 +370,98 @@ impl SolverOptions {
             });
         }
         Ok(())
+    }
+
+    /// Sets [`solver`](Self::solver): the method.
+    #[must_use]
+    pub fn solver(mut self, solver: Solver) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// Sets [`max_iter`](Self::max_iter): MAXITER: outer iterations (pointwise: sweeps).
+    #[must_use]
+    pub fn max_iter(mut self, max_iter: usize) -> Self {
+        self.max_iter = max_iter;
+        self
+    }
+
+    /// Sets [`ftol`](Self::ftol): FTOL: stop when `(F_old − F) ≤ ftol · max(|F_old|, |F|)`.
+    #[must_use]
+    pub fn ftol(mut self, ftol: f64) -> Self {
+        self.ftol = ftol;
+        self
+    }
+
+    /// Sets [`gtol`](Self::gtol): GTOL: stop when `‖g‖ ≤ gtol · ‖g₀‖` (`g₀` = first gradient of the
+    /// run).
+    #[must_use]
+    pub fn gtol(mut self, gtol: f64) -> Self {
+        self.gtol = gtol;
+        self
+    }
+
+    /// Sets [`gtol_abs`](Self::gtol_abs): absolute GTOL: stop when `‖g‖ ≤ gtol_abs`.
+    #[must_use]
+    pub fn gtol_abs(mut self, gtol_abs: f64) -> Self {
+        self.gtol_abs = gtol_abs;
+        self
+    }
+
+    /// Sets [`preconditioner`](Self::preconditioner): preconditioner of the inner CG.
+    #[must_use]
+    pub fn preconditioner(mut self, preconditioner: Preconditioner) -> Self {
+        self.preconditioner = preconditioner;
+        self
+    }
+
+    /// Sets [`hessian`](Self::hessian): Hessian products.
+    #[must_use]
+    pub fn hessian(mut self, hessian: HessianMode) -> Self {
+        self.hessian = hessian;
+        self
+    }
+
+    /// Sets [`cg_max_iter`](Self::cg_max_iter): maximum inner CG iterations per outer iteration.
+    #[must_use]
+    pub fn cg_max_iter(mut self, cg_max_iter: usize) -> Self {
+        self.cg_max_iter = cg_max_iter;
+        self
+    }
+
+    /// Sets [`forcing_max`](Self::forcing_max).
+    #[must_use]
+    pub fn forcing_max(mut self, forcing_max: f64) -> Self {
+        self.forcing_max = forcing_max;
+        self
+    }
+
+    /// Sets [`lbfgs_memory`](Self::lbfgs_memory): L-BFGS memory `m`.
+    #[must_use]
+    pub fn lbfgs_memory(mut self, lbfgs_memory: usize) -> Self {
+        self.lbfgs_memory = lbfgs_memory;
+        self
+    }
+
+    /// Sets [`pointwise_mode`](Self::pointwise_mode): pointwise mode.
+    #[must_use]
+    pub fn pointwise_mode(mut self, pointwise_mode: PointwiseMode) -> Self {
+        self.pointwise_mode = pointwise_mode;
+        self
+    }
+
+    /// Sets [`line_search`](Self::line_search): line-search parameters (TN-LS, L-BFGS).
+    #[must_use]
+    pub fn line_search(mut self, line_search: LineSearchParams) -> Self {
+        self.line_search = line_search;
+        self
+    }
+
+    /// Sets [`stop`](Self::stop): convergence tests over a window of iterations (off by default).
+    #[must_use]
+    pub fn stop(mut self, stop: StopRules) -> Self {
+        self.stop = stop;
+        self
     }
 }
 

@@ -5,6 +5,7 @@ use std::fmt;
 /// Why a line search (Moré–Thuente, MINPACK-2 `dcsrch` info codes) ended without satisfying
 /// the strong Wolfe conditions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum LineSearchFailure {
     /// The interval of uncertainty is below `xtol`.
     Xtol,
@@ -20,6 +21,7 @@ pub enum LineSearchFailure {
 
 /// Why a solver run stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum StopReason {
     /// Relative change of `F` below FTOL.
     Ftol,

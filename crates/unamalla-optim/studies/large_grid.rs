@@ -64,18 +64,16 @@ fn options(
     gtol: f64,
     sigma: f64,
 ) -> SmoothOptions {
-    SmoothOptions {
-        functional: SmoothFunctional::block_smoothing(sigma),
-        solver: SolverOptions {
-            max_iter: 500,
-            ftol,
-            gtol,
-            preconditioner: pre,
-            hessian,
-            ..SolverOptions::new(solver)
-        },
-        ..SmoothOptions::default()
-    }
+    SmoothOptions::default()
+        .functional(SmoothFunctional::block_smoothing(sigma))
+        .solver(
+            SolverOptions::new(solver)
+                .max_iter(500)
+                .ftol(ftol)
+                .gtol(gtol)
+                .preconditioner(pre)
+                .hessian(hessian),
+        )
 }
 
 fn main() {
@@ -133,10 +131,7 @@ fn main() {
                 eprintln!("  cpu {:.3} s", cpu_seconds() - c0);
             }
             if mode != "direct" {
-                let co = CoarseToFineOptions {
-                    smooth: opts.clone(),
-                    ..CoarseToFineOptions::default()
-                };
+                let co = CoarseToFineOptions::default().smooth(opts.clone());
                 let mut g = region(n);
                 let t0 = Instant::now();
                 let c0 = cpu_seconds();

@@ -20,20 +20,17 @@ use unamalla_optim::{
 
 fn optimum(n: usize, sigma: f64) -> Result<(StructuredGrid2, f64), Box<dyn std::error::Error>> {
     let mut g = sinusoidal(n, n, 0.1, 2.0)?;
-    let co = CoarseToFineOptions {
-        smooth: SmoothOptions {
-            functional: SmoothFunctional::block_smoothing(sigma),
-            solver: SolverOptions {
-                max_iter: 500,
-                ftol: 1e-6,
-                gtol: 0.0,
-                preconditioner: Preconditioner::Multigrid,
-                ..SolverOptions::new(Solver::TnTr)
-            },
-            ..SmoothOptions::default()
-        },
-        ..CoarseToFineOptions::default()
-    };
+    let co = CoarseToFineOptions::default().smooth(
+        SmoothOptions::default()
+            .functional(SmoothFunctional::block_smoothing(sigma))
+            .solver(
+                SolverOptions::new(Solver::TnTr)
+                    .max_iter(500)
+                    .ftol(1e-6)
+                    .gtol(0.0)
+                    .preconditioner(Preconditioner::Multigrid),
+            ),
+    );
     let rep = smooth_coarse_to_fine(&mut g, &co, &mut NullObserver)?;
     let f = rep.fine().map_or(f64::NAN, |r| r.f);
     Ok((g, f))

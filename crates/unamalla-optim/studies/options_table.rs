@@ -54,26 +54,14 @@ fn main() {
                     adaptive_k(
                         &topo,
                         &mut x,
-                        &AdaptiveKOptions {
-                            iters_per_k: ipk,
-                            solver: so,
-                            ..Default::default()
-                        },
+                        &AdaptiveKOptions::default().iters_per_k(ipk).solver(so),
                         &mut s,
                     )
                 } else {
                     omega_continuation(
                         &topo,
                         &mut x,
-                        &OmegaOptions {
-                            solver: SolverOptions {
-                                max_iter: 100,
-                                ftol: 1e-8,
-                                gtol: 1e-4,
-                                ..so
-                            },
-                            ..Default::default()
-                        },
+                        &OmegaOptions::default().solver(so.max_iter(100).ftol(1e-8).gtol(1e-4)),
                         &mut s,
                     )
                 }
@@ -118,18 +106,12 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
         Opt::Adaptive(
             "karea-length, linear, lbfgs m = 3",
             HomotopySchedule::Linear,
-            SolverOptions {
-                lbfgs_memory: 3,
-                ..SolverOptions::new(Solver::Lbfgs)
-            },
+            SolverOptions::new(Solver::Lbfgs).lbfgs_memory(3),
         ),
         Opt::Adaptive(
             "karea-length, linear, pointwise by components",
             HomotopySchedule::Linear,
-            SolverOptions {
-                pointwise_mode: PointwiseMode::Components,
-                ..SolverOptions::new(Solver::Pointwise)
-            },
+            SolverOptions::new(Solver::Pointwise).pointwise_mode(PointwiseMode::Components),
         ),
         Opt::Classic(
             "area-length σ = 0.5, tn-tr",
@@ -161,12 +143,10 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
                     let r = adaptive_k(
                         &topo,
                         &mut x,
-                        &AdaptiveKOptions {
-                            iters_per_k: ipk,
-                            solver: so.clone(),
-                            schedule: *schedule,
-                            ..Default::default()
-                        },
+                        &AdaptiveKOptions::default()
+                            .iters_per_k(ipk)
+                            .solver(so.clone())
+                            .schedule(*schedule),
                         &mut s,
                     );
                     (label, r)
@@ -178,13 +158,10 @@ fn options_table(fixtures: &[(String, StructuredGrid2)]) {
                     let r = classic_combination(
                         &topo,
                         &mut x,
-                        &ClassicOptions {
-                            combination: *c,
-                            sigma: *sigma,
-                            presmooth: 0,
-                            eps: 0.01,
-                            solver: tn.clone(),
-                        },
+                        &ClassicOptions::new(*c, *sigma)
+                            .presmooth(0)
+                            .eps(0.01)
+                            .solver(tn.clone()),
                         &mut s,
                     );
                     (label, r)

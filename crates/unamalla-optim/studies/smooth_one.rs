@@ -21,14 +21,8 @@ fn main() {
     let mut g = sinusoidal(n, n, 0.1, 2.0).expect("region");
     let mut obs = ProgressObserver::default();
     let t = Instant::now();
-    let opts = SmoothOptions {
-        solver: SolverOptions {
-            max_iter: 500,
-            preconditioner: pre,
-            ..SolverOptions::new(s)
-        },
-        ..SmoothOptions::default()
-    };
+    let opts =
+        SmoothOptions::default().solver(SolverOptions::new(s).max_iter(500).preconditioner(pre));
     let r = smooth(&mut g, &opts, &mut obs).expect("smooth");
     obs.finish();
     println!(

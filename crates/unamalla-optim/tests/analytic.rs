@@ -240,29 +240,24 @@ impl ElementMeasures for Rosenbrock {
 fn all_variants() -> Vec<SolverOptions> {
     let mut v = Vec::new();
     for s in Solver::ALL {
-        v.push(SolverOptions {
-            max_iter: 5000,
-            gtol: 1e-10,
-            ftol: 0.0,
-            ..SolverOptions::new(s)
-        });
+        v.push(SolverOptions::new(s).max_iter(5000).gtol(1e-10).ftol(0.0));
     }
     for m in [3, 5, 1] {
-        v.push(SolverOptions {
-            lbfgs_memory: m,
-            max_iter: 5000,
-            gtol: 1e-10,
-            ftol: 0.0,
-            ..SolverOptions::new(Solver::Lbfgs)
-        });
+        v.push(
+            SolverOptions::new(Solver::Lbfgs)
+                .lbfgs_memory(m)
+                .max_iter(5000)
+                .gtol(1e-10)
+                .ftol(0.0),
+        );
     }
-    v.push(SolverOptions {
-        pointwise_mode: PointwiseMode::Components,
-        max_iter: 20000,
-        gtol: 1e-10,
-        ftol: 0.0,
-        ..SolverOptions::new(Solver::Pointwise)
-    });
+    v.push(
+        SolverOptions::new(Solver::Pointwise)
+            .pointwise_mode(PointwiseMode::Components)
+            .max_iter(20000)
+            .gtol(1e-10)
+            .ftol(0.0),
+    );
     v
 }
 
@@ -377,16 +372,11 @@ fn fletcher_reeves_ends_within_n_iterations_on_a_quadratic() {
     for nodes in [3, 4] {
         let xstar: Vec<f64> = (0..2 * nodes).map(|i| 1.0 + 0.5 * i as f64).collect();
         let q = Quadratic::new(nodes, &xstar);
-        let opts = SolverOptions {
-            max_iter: 100,
-            gtol: 1e-9,
-            ftol: 0.0,
-            line_search: LineSearchParams {
-                gtol: 1e-10,
-                ..LineSearchParams::default()
-            },
-            ..SolverOptions::new(Solver::NcgFr)
-        };
+        let opts = SolverOptions::new(Solver::NcgFr)
+            .max_iter(100)
+            .gtol(1e-9)
+            .ftol(0.0)
+            .line_search(LineSearchParams::default().gtol(1e-10));
         let mut x = vec![0.0; 2 * nodes];
         let mut obs = NullObserver;
         let mut s = Session::new(&q, &x, &mut obs);

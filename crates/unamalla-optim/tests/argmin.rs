@@ -33,12 +33,10 @@ fn winslow(n: usize) -> (Winslow, Vec<f64>) {
 /// Our TN-TR to a tight gradient tolerance: the reference minimum.
 fn reference_min<P: Problem>(p: &P, x0: &[f64]) -> f64 {
     let mut x = x0.to_vec();
-    let opts = SolverOptions {
-        max_iter: 500,
-        ftol: 0.0,
-        gtol: 1e-10,
-        ..SolverOptions::new(Solver::TnTr)
-    };
+    let opts = SolverOptions::new(Solver::TnTr)
+        .max_iter(500)
+        .ftol(0.0)
+        .gtol(1e-10);
     let mut obs = NullObserver;
     let mut session = Session::new(p, &x, &mut obs);
     let r = minimize(p, &mut x, &opts, &mut session).unwrap();

@@ -31,10 +31,7 @@ fn guarded_run<P: Problem>(p: &P, x0: &[f64], thr: f64, iters: usize) -> (f64, f
     let mut obs = HistoryObserver::default();
     let mut session = Session::new(p, &x, &mut obs);
     session.guard_threshold = thr;
-    let opts = SolverOptions {
-        max_iter: iters,
-        ..SolverOptions::new(Solver::TnTr)
-    };
+    let opts = SolverOptions::new(Solver::TnTr).max_iter(iters);
     minimize_with(p, &mut x, &opts, &mut session, None).unwrap();
     let last = session.masked_min(p, &x);
     let seen = obs.history.iter().map(|m| m.alfamin).fold(last, f64::min);

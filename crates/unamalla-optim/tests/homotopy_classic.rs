@@ -49,10 +49,7 @@ fn fixture() -> StructuredGrid2 {
 }
 
 fn run(schedule: HomotopySchedule) -> (Vec<f64>, bool, usize) {
-    run_with(&AdaptiveKOptions {
-        schedule,
-        ..Default::default()
-    })
+    run_with(&AdaptiveKOptions::default().schedule(schedule))
 }
 
 fn run_with(opts: &AdaptiveKOptions) -> (Vec<f64>, bool, usize) {
@@ -169,10 +166,7 @@ fn classic_smooth_options_parse_and_keep_a_convex_start_convex() {
         let mut h = g.clone();
         let r = smooth(
             &mut h,
-            &SmoothOptions {
-                functional: f,
-                ..Default::default()
-            },
+            &SmoothOptions::default().functional(f),
             &mut NullObserver,
         )
         .unwrap();
@@ -193,10 +187,7 @@ fn ivanenko_functional_untangles_the_folded_ivanenko_grid_to_eps_convexity() {
     let mut g = fixture();
     let r = smooth(
         &mut g,
-        &SmoothOptions {
-            functional: "ivanenko".parse().unwrap(),
-            ..Default::default()
-        },
+        &SmoothOptions::default().functional("ivanenko".parse().unwrap()),
         &mut NullObserver,
     )
     .unwrap();
@@ -214,10 +205,7 @@ fn ivanenko_functional_untangles_the_folded_ivanenko_grid_to_eps_convexity() {
     let before = g.clone();
     let r2 = smooth(
         &mut g,
-        &SmoothOptions {
-            functional: SmoothFunctional::Ivanenko,
-            ..Default::default()
-        },
+        &SmoothOptions::default().functional(SmoothFunctional::Ivanenko),
         &mut NullObserver,
     )
     .unwrap();
@@ -249,12 +237,10 @@ fn stopping_at_the_target_bound_ends_a_homotopy_the_thesis_loop_cannot_end() {
         let mut x = topo.initial_x();
         let mut obs = NullObserver;
         let mut s = Session::new(&probe, &x, &mut obs);
-        let opts = AdaptiveKOptions {
-            classic: false,
-            max_updates: 40,
-            stop_at_target,
-            ..Default::default()
-        };
+        let opts = AdaptiveKOptions::default()
+            .classic(false)
+            .max_updates(40)
+            .stop_at_target(stop_at_target);
         let r = adaptive_k(&topo, &mut x, &opts, &mut s).unwrap();
         // α₋ over the triangles with a free vertex (the corner (0, 0) of the lower left cell,
         // 0.5δ, is boundary data)

@@ -19,14 +19,9 @@ fn min_rel(g: &StructuredGrid2) -> (f64, usize) {
 }
 
 fn opts(functional: &str, solver: Solver) -> SmoothOptions {
-    SmoothOptions {
-        functional: functional.parse().unwrap(),
-        solver: SolverOptions {
-            max_iter: 100,
-            ..SolverOptions::new(solver)
-        },
-        ..SmoothOptions::default()
-    }
+    SmoothOptions::default()
+        .functional(functional.parse().unwrap())
+        .solver(SolverOptions::new(solver).max_iter(100))
 }
 
 #[test]
@@ -147,10 +142,7 @@ fn algorithm_a_untangles_a_perturbed_hex_grid_and_b_keeps_it_convex() {
     let g = hex_grid(5, 1.6);
     let mut mesh = HexMesh::from_grid(&g);
     let before = mesh.nodes().to_vec();
-    let opts = HexSmoothOptions {
-        driver: HexDriver::AlgorithmAB,
-        ..HexSmoothOptions::default()
-    };
+    let opts = HexSmoothOptions::default().driver(HexDriver::AlgorithmAB);
     let rep = smooth_hex(&mut mesh, &opts, &mut NullObserver).unwrap();
     assert!(rep.initial_inocon > 0, "start must be folded: {rep:?}");
     assert!(rep.convex, "{rep:?}");

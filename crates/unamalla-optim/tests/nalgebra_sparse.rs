@@ -40,14 +40,12 @@ fn cholesky_solve_equals_our_cg_on_the_length_functional() {
     let f = QuadFunctional::new(topo, Length);
     let d = cholesky_newton_step(&f, &x0);
     let mut x = x0.clone();
-    let opts = SolverOptions {
-        max_iter: 50,
-        ftol: 0.0,
-        gtol: 1e-13,
-        cg_max_iter: 1000,
-        preconditioner: Preconditioner::None,
-        ..SolverOptions::new(Solver::TnTr)
-    };
+    let opts = SolverOptions::new(Solver::TnTr)
+        .max_iter(50)
+        .ftol(0.0)
+        .gtol(1e-13)
+        .cg_max_iter(1000)
+        .preconditioner(Preconditioner::None);
     let mut obs = NullObserver;
     let mut session = Session::new(&f, &x, &mut obs);
     minimize(&f, &mut x, &opts, &mut session).unwrap();
@@ -70,12 +68,10 @@ fn cholesky_newton_step_at_the_winslow_minimum_is_negligible_and_spd() {
     let mut x = topo.initial_x();
     let f = QuadFunctional::new(topo, Smoothness::new());
     let d0 = cholesky_newton_step(&f, &x);
-    let opts = SolverOptions {
-        max_iter: 200,
-        ftol: 0.0,
-        gtol: 1e-10,
-        ..SolverOptions::new(Solver::TnTr)
-    };
+    let opts = SolverOptions::new(Solver::TnTr)
+        .max_iter(200)
+        .ftol(0.0)
+        .gtol(1e-10);
     let mut obs = NullObserver;
     let mut session = Session::new(&f, &x, &mut obs);
     minimize(&f, &mut x, &opts, &mut session).unwrap();

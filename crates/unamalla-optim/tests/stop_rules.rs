@@ -15,17 +15,14 @@ use unamalla_optim::status::{Status, StopReason};
 /// (6.8) σ = 0.1 with TN-TR, every one-step test off (FTOL = GTOL = 0), so only the window
 /// rule (or MAXITER) can end the run.
 fn opts(stop: StopRules, max_iter: usize) -> SmoothOptions {
-    SmoothOptions {
-        solver: SolverOptions {
-            max_iter,
-            ftol: 0.0,
-            gtol: 0.0,
-            cg_max_iter: 40,
-            stop,
-            ..SolverOptions::default()
-        },
-        ..SmoothOptions::default()
-    }
+    SmoothOptions::default().solver(
+        SolverOptions::default()
+            .max_iter(max_iter)
+            .ftol(0.0)
+            .gtol(0.0)
+            .cg_max_iter(40)
+            .stop(stop),
+    )
 }
 
 fn grid() -> StructuredGrid2 {
@@ -207,10 +204,7 @@ fn stop_rules_check_by_hand() {
 #[test]
 fn an_explicit_time_limit_is_its_own_status_never_by_user() {
     let mut g = grid();
-    let o = SmoothOptions {
-        time_limit: Some(0.0),
-        ..opts(StopRules::default(), 1000)
-    };
+    let o = (opts(StopRules::default(), 1000)).time_limit(Some(0.0));
     let rep = smooth(&mut g, &o, &mut HistoryObserver::default()).unwrap();
     assert_eq!(
         rep.status,
@@ -223,10 +217,7 @@ fn an_explicit_time_limit_is_its_own_status_never_by_user() {
     assert!(rep.iterations() <= 1, "{}", rep.iterations());
     // a bad limit is a typed error naming the option
     for bad in [-1.0, f64::NAN, f64::INFINITY] {
-        let o = SmoothOptions {
-            time_limit: Some(bad),
-            ..opts(StopRules::default(), 10)
-        };
+        let o = (opts(StopRules::default(), 10)).time_limit(Some(bad));
         match smooth(&mut grid(), &o, &mut HistoryObserver::default()) {
             Err(unamalla_optim::OptimError::InvalidOption { name, .. }) => {
                 assert_eq!(name, "time_limit")

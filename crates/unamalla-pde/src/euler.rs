@@ -72,8 +72,18 @@ pub enum EulerError {
     },
 }
 
-/// Options of [`EulerSolver::run`].
+/// Options of [`EulerSolver::run`]. Build them from [`EulerOptions::default`] or
+/// [`EulerOptions::until`] and the setters; new options may be added in minor releases.
+///
+/// ```
+/// use unamalla_pde::euler::EulerOptions;
+///
+/// let opts = EulerOptions::until(0.5).gamma(1.3).cfl(0.5).max_steps(40);
+/// assert_eq!((opts.end_time, opts.gamma, opts.cfl, opts.max_steps), (0.5, 1.3, 0.5, 40));
+/// assert_eq!(EulerOptions::default().end_time(0.2).end_time, 0.2);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct EulerOptions {
     /// Ratio of specific heats `γ` (1.4).
     pub gamma: f64,
@@ -103,6 +113,35 @@ impl EulerOptions {
             end_time: t,
             ..Self::default()
         }
+    }
+
+    /// Sets [`gamma`](Self::gamma): ratio of specific heats `γ` (1.4).
+    #[must_use]
+    pub fn gamma(mut self, gamma: f64) -> Self {
+        self.gamma = gamma;
+        self
+    }
+
+    /// Sets [`cfl`](Self::cfl): Courant number (0.8; at most 1).
+    #[must_use]
+    pub fn cfl(mut self, cfl: f64) -> Self {
+        self.cfl = cfl;
+        self
+    }
+
+    /// Sets [`end_time`](Self::end_time): end time.
+    #[must_use]
+    pub fn end_time(mut self, end_time: f64) -> Self {
+        self.end_time = end_time;
+        self
+    }
+
+    /// Sets [`max_steps`](Self::max_steps): steps at most (the run stops there even before
+    /// `end_time`).
+    #[must_use]
+    pub fn max_steps(mut self, max_steps: usize) -> Self {
+        self.max_steps = max_steps;
+        self
     }
 }
 

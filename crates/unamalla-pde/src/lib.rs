@@ -283,6 +283,7 @@ impl Equation {
 
 /// Which linear solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Method {
     /// Successive over-relaxation; `omega: None` chooses ω automatically (module docs).
     Sor {
@@ -299,8 +300,33 @@ impl Default for Method {
     }
 }
 
-/// Options of the solvers.
+impl Method {
+    /// The method's short name: `sor` or `direct`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Sor { .. } => "sor",
+            Method::Direct => "direct",
+        }
+    }
+}
+
+/// Options of the solvers. Build them from [`SolveOptions::default`] and the setters; new
+/// options may be added in minor releases.
+///
+/// ```
+/// use unamalla_pde::{Method, SolveOptions};
+///
+/// let opts = SolveOptions::default()
+///     .method(Method::Sor { omega: Some(1.5) })
+///     .tol(1e-9)
+///     .max_iterations(500);
+/// assert_eq!(opts.method, Method::Sor { omega: Some(1.5) });
+/// assert_eq!((opts.tol, opts.max_iterations), (1e-9, 500));
+/// assert_eq!(opts.method.name(), "sor");
+/// assert_eq!(Method::Direct.name(), "direct");
+/// ```
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct SolveOptions {
     /// The solver.
     pub method: Method,
@@ -318,6 +344,29 @@ impl Default for SolveOptions {
             tol: 1e-11,
             max_iterations: 200_000,
         }
+    }
+}
+
+impl SolveOptions {
+    /// Sets [`method`](Self::method): the solver.
+    #[must_use]
+    pub fn method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// Sets [`tol`](Self::tol).
+    #[must_use]
+    pub fn tol(mut self, tol: f64) -> Self {
+        self.tol = tol;
+        self
+    }
+
+    /// Sets [`max_iterations`](Self::max_iterations): SOR sweep limit.
+    #[must_use]
+    pub fn max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
     }
 }
 

@@ -33,10 +33,7 @@ fn solve(grid: &StructuredGrid2, man: &Manufactured, k: [f64; 4]) -> Result<Solu
     let eq = man.equation(k[0], k[1], k[2], k[3]);
     let r = match solve_grid(grid, &eq, &man.sides(), &SolveOptions::default()) {
         Err(PdeError::SorDiverged { .. } | PdeError::NotConverged { .. }) => {
-            let direct = SolveOptions {
-                method: Method::Direct,
-                ..SolveOptions::default()
-            };
+            let direct = SolveOptions::default().method(Method::Direct);
             solve_grid(grid, &eq, &man.sides(), &direct)
         }
         r => r,
@@ -64,10 +61,7 @@ fn optimized(grid: &StructuredGrid2) -> (StructuredGrid2, f64) {
         .skip_while(|a| a != "--functional")
         .nth(1)
         .unwrap_or_else(|| "karea-length".into());
-    let opts = SmoothOptions {
-        functional: name.parse().expect("functional name"),
-        ..SmoothOptions::default()
-    };
+    let opts = SmoothOptions::default().functional(name.parse().expect("functional name"));
     let mut g = grid.clone();
     let t = Instant::now();
     if let Err(e) = smooth(&mut g, &opts, &mut NullObserver) {

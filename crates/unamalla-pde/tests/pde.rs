@@ -60,10 +60,7 @@ fn second_order_on_tfi_grids_of_a_curved_region() {
 fn second_order_on_optimized_grids_of_a_curved_region() {
     // the thesis's default functional kArea-Length (σ = 0.5); its optimum is the discretization
     // of a smooth map, so the optimized grids form a smooth family too
-    let opts = SmoothOptions {
-        functional: "karea-length".parse().unwrap(),
-        ..SmoothOptions::default()
-    };
+    let opts = SmoothOptions::default().functional("karea-length".parse().unwrap());
     let grids: Vec<_> = [21, 41, 81]
         .iter()
         .map(|&n| {

@@ -155,20 +155,14 @@ pub fn choose_layout_excluding(
     type Cand = (&'static str, Option<Vec<(DVec2, DVec2)>>, Decomposition);
     // the candidate layouts are independent: built (and predicted below) in parallel, the
     // results kept in the order of the list, so the choice does not depend on the threads
-    let conc_opts = DecomposeOptions {
-        layout: Layout::Concavity,
-        ..opts.clone()
-    };
+    let conc_opts = opts.clone().layout(Layout::Concavity);
     let (conc, chord_layouts) = rayon::join(
         || decompose(region, &conc_opts),
         || {
             LAYOUT_ASPECTS
                 .par_iter()
                 .map(|&(name, aspect)| {
-                    let o = DecomposeOptions {
-                        chord_aspect: aspect,
-                        ..opts.clone()
-                    };
+                    let o = opts.clone().chord_aspect(aspect);
                     (name, chord_layout_cuts(region, &o))
                 })
                 .collect::<Vec<_>>()
@@ -251,10 +245,7 @@ pub fn choose_layout_excluding(
                 .map(|(_, a)| *a);
             let (d, p, added, tried) = match (cuts, aspect) {
                 (Some(cuts), Some(aspect)) => {
-                    let o = DecomposeOptions {
-                        chord_aspect: aspect,
-                        ..opts.clone()
-                    };
+                    let o = opts.clone().chord_aspect(aspect);
                     resplit(region, &o, size, cuts, d, p)
                 }
                 _ => (d, p, 0, 0),

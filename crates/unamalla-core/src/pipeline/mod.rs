@@ -106,6 +106,7 @@ impl Default for MeshSize {
 /// The decomposition strategy (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "snake_case")]
+#[non_exhaustive]
 pub enum Strategy {
     /// Straight cuts into admissible blocks with four corners ([Méndez 2023, Ch. 4]).
     #[default]
@@ -398,7 +399,23 @@ impl Mesher {
         self.decomposition = Some(d);
         self
     }
-    /// Smoothing options.
+    /// Smoothing options (default [`default_smooth_options`]). The options structs of the
+    /// stage crates are `#[non_exhaustive]`: start from a default or a constructor and chain
+    /// the setters (named after the fields), or assign the fields of a default value.
+    ///
+    /// ```
+    /// use unamalla_core::optim::SmoothOptions;
+    /// use unamalla_core::pipeline::default_smooth_options;
+    /// use unamalla_core::Mesher;
+    ///
+    /// let base = default_smooth_options();
+    /// let opts = base.clone().eps(0.02).solver(base.solver.clone().max_iter(300));
+    /// assert_eq!((opts.eps, opts.solver.max_iter), (0.02, 300));
+    /// let mut other = SmoothOptions::default();
+    /// other.solver.max_iter = 300;
+    /// assert_eq!(other.solver.max_iter, opts.solver.max_iter);
+    /// let _mesher = Mesher::new().cells(5_000).smooth_options(opts);
+    /// ```
     pub fn smooth_options(mut self, opts: SmoothOptions) -> Self {
         self.smooth_opts = opts;
         self

@@ -704,10 +704,7 @@ pub fn simplify_for_mesh(
         if r.relative_area_change.abs() <= MAX_SIMPLIFY_AREA_CHANGE {
             break;
         }
-        let smaller = SimplifyOptions {
-            epsilon: Some(0.5 * r.epsilon),
-            ..opts.clone()
-        };
+        let smaller = opts.clone().epsilon(Some(0.5 * r.epsilon));
         let retry = simplify_region(region, &smaller)?;
         // keep the coarser result when the finer one brings back a near contact (a vertex
         // within 10⁻⁶ of the region's size of a non-adjacent edge): no mesh can resolve it

@@ -141,10 +141,7 @@ pub fn classify_region(region: &Region, mode: SumMode) -> Result<Classification,
             initial_condition_holds = total == 4 * (1 - holes as i64);
             if !initial_condition_holds {
                 let all: Vec<f64> = vertices.iter().map(|v| v.alpha).collect();
-                let opts = VertexClassOptions {
-                    holes,
-                    ..VertexClassOptions::default()
-                };
+                let opts = VertexClassOptions::default().holes(holes);
                 let c = classify_vertices(&all, &opts)
                     .map_err(|source| SubmapError::Classification { ring: None, source })?;
                 ilp_cost = c.cost;

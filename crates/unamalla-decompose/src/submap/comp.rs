@@ -149,10 +149,7 @@ pub(crate) fn build(mut points: Vec<LPoint>, options: &SubmapOptions) -> Result<
             .collect(),
         twins,
     };
-    let iopts = IntervalOptions {
-        include_max_term: options.include_max_term,
-        ..IntervalOptions::new(h)
-    };
+    let iopts = IntervalOptions::new(h).include_max_term(options.include_max_term);
     let sol = assign_intervals(&problem, &iopts).map_err(SubmapError::Intervals)?;
 
     // nodes and the computational walk

@@ -121,6 +121,7 @@ pub enum SumMode {
 
 /// Options of [`submap`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct SubmapOptions {
     /// Target element size `h` (region units): `N_e = max(1, round(l(e)/h))` and the CDT spacing.
     pub target_size: f64,
@@ -149,10 +150,46 @@ impl SubmapOptions {
             max_attempts: 4,
         }
     }
+
+    /// Sets [`sum_mode`](Self::sum_mode): per-loop or global sums in the vertex-classification ILP.
+    #[must_use]
+    pub fn sum_mode(mut self, sum_mode: SumMode) -> Self {
+        self.sum_mode = sum_mode;
+        self
+    }
+
+    /// Sets [`include_max_term`](Self::include_max_term).
+    #[must_use]
+    pub fn include_max_term(mut self, include_max_term: bool) -> Self {
+        self.include_max_term = include_max_term;
+        self
+    }
+
+    /// Sets [`keep_vertex_angle_deg`](Self::keep_vertex_angle_deg).
+    #[must_use]
+    pub fn keep_vertex_angle_deg(mut self, keep_vertex_angle_deg: f64) -> Self {
+        self.keep_vertex_angle_deg = keep_vertex_angle_deg;
+        self
+    }
+
+    /// Sets [`max_pieces`](Self::max_pieces): safety limit on the number of pieces.
+    #[must_use]
+    pub fn max_pieces(mut self, max_pieces: usize) -> Self {
+        self.max_pieces = max_pieces;
+        self
+    }
+
+    /// Sets [`max_attempts`](Self::max_attempts).
+    #[must_use]
+    pub fn max_attempts(mut self, max_attempts: usize) -> Self {
+        self.max_attempts = max_attempts;
+        self
+    }
 }
 
 /// Why submapping failed. Every variant names the ring, hole, piece or point concerned.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SubmapError {
     /// The target size is not a finite positive number.
     #[error("submapping: target size must be finite and > 0, got {0}")]

@@ -382,11 +382,9 @@ fn label_junctions(current: &mut [LPoint]) -> Result<bool, SubmapError> {
         .iter()
         .map(|p| if p.junction { 1.0 } else { 1000.0 })
         .collect();
-    let opts = VertexClassOptions {
-        rho: Some(w.clone()),
-        omega: Some(w),
-        ..VertexClassOptions::default()
-    };
+    let opts = VertexClassOptions::default()
+        .rho(Some(w.clone()))
+        .omega(Some(w));
     let c = classify_vertices_to_sum(&abar, 4, &opts).map_err(SubmapError::MergedClassification)?;
     for (p, &l) in current.iter_mut().zip(&c.labels) {
         p.label = l as i64;

@@ -23,10 +23,7 @@ pub fn pipeline_simplify(region: &Region) -> Region {
         if r.relative_area_change.abs() <= 0.01 {
             break;
         }
-        let smaller = SimplifyOptions {
-            epsilon: Some(0.5 * r.epsilon),
-            ..opts.clone()
-        };
+        let smaller = opts.clone().epsilon(Some(0.5 * r.epsilon));
         r = simplify_region(region, &smaller).expect("default simplification");
     }
     let simplified = r.region;

@@ -15,6 +15,7 @@ use crate::traits::{HasHexCells, HasQuadCells};
 
 /// Options of [`QualityReport::for_quads_with`] / [`QualityReport::for_hexes_with`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct ReportOptions {
     /// Number of μ histogram bins over `[0, 1]` (default 20, bins of 0.05 as in the thesis's
     /// "0.95 ≤ μ ≤ 1" example).
@@ -36,6 +37,36 @@ impl Default for ReportOptions {
             tet_epsilon: 0.0,
             planarity_tolerance: 1e-2,
         }
+    }
+}
+
+impl ReportOptions {
+    /// Sets [`histogram_bins`](Self::histogram_bins).
+    #[must_use]
+    pub fn histogram_bins(mut self, histogram_bins: usize) -> Self {
+        self.histogram_bins = histogram_bins;
+        self
+    }
+
+    /// Sets [`epsilon`](Self::epsilon).
+    #[must_use]
+    pub fn epsilon(mut self, epsilon: f64) -> Self {
+        self.epsilon = epsilon;
+        self
+    }
+
+    /// Sets [`tet_epsilon`](Self::tet_epsilon).
+    #[must_use]
+    pub fn tet_epsilon(mut self, tet_epsilon: f64) -> Self {
+        self.tet_epsilon = tet_epsilon;
+        self
+    }
+
+    /// Sets [`planarity_tolerance`](Self::planarity_tolerance).
+    #[must_use]
+    pub fn planarity_tolerance(mut self, planarity_tolerance: f64) -> Self {
+        self.planarity_tolerance = planarity_tolerance;
+        self
     }
 }
 

@@ -5,6 +5,7 @@ use super::*;
 
 /// The adaptive functional `f₁` and its partner `f₂` ([González Flores, Table 5.2, §A.4.3]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum KFunctional {
     /// `kSmooth-Area`: k-Smoothness with Area.
     KSmoothArea,
@@ -23,6 +24,7 @@ pub enum KFunctional {
 /// `t = (k₀ − k)/(k₀ − k*)` ((5.20) is the linear path), so the weight of the classic functional
 /// `f₂` is `σ̂ = (1 − σ)·σ̃(t)` (5.19) ([`homotopy_weight`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum HomotopySchedule {
     /// `σ̃(t) = t`: the linear homotopy (5.20), UNAMALLA's practical scheme.
     #[default]
@@ -105,6 +107,7 @@ pub fn homotopy_weight(
 
 /// Options of [`adaptive_k`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct AdaptiveKOptions {
     /// The functional pair.
     pub functional: KFunctional,
@@ -156,6 +159,79 @@ impl Default for AdaptiveKOptions {
             schedule: HomotopySchedule::Linear,
             stop_at_target: false,
         }
+    }
+}
+
+impl AdaptiveKOptions {
+    /// Sets [`functional`](Self::functional): the functional pair.
+    #[must_use]
+    pub fn functional(mut self, functional: KFunctional) -> Self {
+        self.functional = functional;
+        self
+    }
+
+    /// Sets [`sigma`](Self::sigma).
+    #[must_use]
+    pub fn sigma(mut self, sigma: f64) -> Self {
+        self.sigma = sigma;
+        self
+    }
+
+    /// Sets [`k_star`](Self::k_star).
+    #[must_use]
+    pub fn k_star(mut self, k_star: f64) -> Self {
+        self.k_star = k_star;
+        self
+    }
+
+    /// Sets [`iters_per_k`](Self::iters_per_k): solver iterations per `k` update.
+    #[must_use]
+    pub fn iters_per_k(mut self, iters_per_k: usize) -> Self {
+        self.iters_per_k = iters_per_k;
+        self
+    }
+
+    /// Sets [`max_updates`](Self::max_updates): maximum number of `k` updates.
+    #[must_use]
+    pub fn max_updates(mut self, max_updates: usize) -> Self {
+        self.max_updates = max_updates;
+        self
+    }
+
+    /// Sets [`presmooth`](Self::presmooth): length pre-smoothing iterations (0 = "Previous
+    /// Smoothness: No").
+    #[must_use]
+    pub fn presmooth(mut self, presmooth: usize) -> Self {
+        self.presmooth = presmooth;
+        self
+    }
+
+    /// Sets [`classic`](Self::classic): run the classic phase after the homotopy.
+    #[must_use]
+    pub fn classic(mut self, classic: bool) -> Self {
+        self.classic = classic;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver).
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// Sets [`schedule`](Self::schedule).
+    #[must_use]
+    pub fn schedule(mut self, schedule: HomotopySchedule) -> Self {
+        self.schedule = schedule;
+        self
+    }
+
+    /// Sets [`stop_at_target`](Self::stop_at_target).
+    #[must_use]
+    pub fn stop_at_target(mut self, stop_at_target: bool) -> Self {
+        self.stop_at_target = stop_at_target;
+        self
     }
 }
 

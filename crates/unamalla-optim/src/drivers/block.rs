@@ -5,6 +5,7 @@ use super::*;
 
 /// Options of [`block_smoothing`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct BlockSmoothingOptions {
     /// σ of (6.8): weight of `H_ω` (Laguna Honda example: 0.1).
     pub sigma: f64,
@@ -42,6 +43,65 @@ impl Default for BlockSmoothingOptions {
             sigma_continuation: Vec::new(),
             continuation_iter: 50,
         }
+    }
+}
+
+impl BlockSmoothingOptions {
+    /// Sets [`sigma`](Self::sigma): σ of (6.8): weight of `H_ω` (Laguna Honda example: 0.1).
+    #[must_use]
+    pub fn sigma(mut self, sigma: f64) -> Self {
+        self.sigma = sigma;
+        self
+    }
+
+    /// Sets [`density`](Self::density): boundary density `w` of (6.9) (1 = the unweighted (6.8)).
+    #[must_use]
+    pub fn density(mut self, density: f64) -> Self {
+        self.density = density;
+        self
+    }
+
+    /// Sets [`layers`](Self::layers): width of the boundary band of (6.9) in cell layers.
+    #[must_use]
+    pub fn layers(mut self, layers: usize) -> Self {
+        self.layers = layers;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`untangle`](Self::untangle).
+    #[must_use]
+    pub fn untangle(mut self, untangle: AdaptiveKOptions) -> Self {
+        self.untangle = untangle;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver): solver options of the (6.8) minimization.
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// Sets [`sigma_continuation`](Self::sigma_continuation).
+    #[must_use]
+    pub fn sigma_continuation(mut self, sigma_continuation: Vec<f64>) -> Self {
+        self.sigma_continuation = sigma_continuation;
+        self
+    }
+
+    /// Sets [`continuation_iter`](Self::continuation_iter): iteration cap of each σ-continuation
+    /// stage.
+    #[must_use]
+    pub fn continuation_iter(mut self, continuation_iter: usize) -> Self {
+        self.continuation_iter = continuation_iter;
+        self
     }
 }
 

@@ -7,6 +7,7 @@ use super::*;
 /// `Area-Ortho.` entries of the Functional menu), each the convex combination `σ·F̃₁ + (1 − σ)·F̃₂`
 /// of normalized functionals (§5.1; σ is the weight of the first-named functional, (5.1)–(5.2)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum ClassicCombination {
     /// t-Area – Length: `σ·Σα²/(Nᾱ²) + (1 − σ)·Σl/(2Nᾱ)` (Table 5.1 weights .95, .7, .5; the
     /// text recommends 0.9 as an automatic value; the menu's default is 0.5).
@@ -51,6 +52,7 @@ impl ClassicCombination {
 
 /// Options of [`classic_combination`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct ClassicOptions {
     /// The pair.
     pub combination: ClassicCombination,
@@ -62,6 +64,57 @@ pub struct ClassicOptions {
     pub eps: f64,
     /// Solver options.
     pub solver: SolverOptions,
+}
+
+impl ClassicOptions {
+    /// The pair `combination` with weight `sigma`, no pre-smoothing, ε = 0.01 and the default
+    /// solver options (the values [`smooth`] uses for [`SmoothFunctional::Classic`] with the
+    /// default [`SmoothOptions`]).
+    pub fn new(combination: ClassicCombination, sigma: f64) -> Self {
+        Self {
+            combination,
+            sigma,
+            presmooth: 0,
+            eps: 0.01,
+            solver: SolverOptions::default(),
+        }
+    }
+
+    /// Sets [`combination`](Self::combination): the pair.
+    #[must_use]
+    pub fn combination(mut self, combination: ClassicCombination) -> Self {
+        self.combination = combination;
+        self
+    }
+
+    /// Sets [`sigma`](Self::sigma): σ, the weight of t-Area.
+    #[must_use]
+    pub fn sigma(mut self, sigma: f64) -> Self {
+        self.sigma = sigma;
+        self
+    }
+
+    /// Sets [`presmooth`](Self::presmooth): length pre-smoothing iterations (0 = "Previous
+    /// Smoothness: No").
+    #[must_use]
+    pub fn presmooth(mut self, presmooth: usize) -> Self {
+        self.presmooth = presmooth;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps): ε of the reported ε-convexity (`α₋ > ε·ᾱ`).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver): solver options.
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
+    }
 }
 
 /// Minimizes a classic combination ([`ClassicCombination`]) from `x` with the safeguard (a

@@ -5,6 +5,7 @@ use super::*;
 
 /// Options of Algorithm B ([`coplanarity_continuation`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct CoplanarityOptions {
     /// Fixed `ω` relative to the mean Jacobian ([Cortés Aguirre 2012, Algorithm B]: `10⁻⁸`).
     pub omega_rel: f64,
@@ -35,6 +36,55 @@ impl CoplanarityOptions {
             stop_cos: None,
             ..Self::default()
         }
+    }
+
+    /// Sets [`omega_rel`](Self::omega_rel).
+    #[must_use]
+    pub fn omega_rel(mut self, omega_rel: f64) -> Self {
+        self.omega_rel = omega_rel;
+        self
+    }
+
+    /// Sets [`mu0`](Self::mu0).
+    #[must_use]
+    pub fn mu0(mut self, mu0: f64) -> Self {
+        self.mu0 = mu0;
+        self
+    }
+
+    /// Sets [`mu_min`](Self::mu_min): stop when `μ ≤ mu_min` (10⁻¹²).
+    #[must_use]
+    pub fn mu_min(mut self, mu_min: f64) -> Self {
+        self.mu_min = mu_min;
+        self
+    }
+
+    /// Sets [`planarity_tol`](Self::planarity_tol).
+    #[must_use]
+    pub fn planarity_tol(mut self, planarity_tol: f64) -> Self {
+        self.planarity_tol = planarity_tol;
+        self
+    }
+
+    /// Sets [`stop_cos`](Self::stop_cos).
+    #[must_use]
+    pub fn stop_cos(mut self, stop_cos: Option<f64>) -> Self {
+        self.stop_cos = stop_cos;
+        self
+    }
+
+    /// Sets [`check_every`](Self::check_every).
+    #[must_use]
+    pub fn check_every(mut self, check_every: usize) -> Self {
+        self.check_every = check_every;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver): solver options of each minimization.
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
     }
 }
 

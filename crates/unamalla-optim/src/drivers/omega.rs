@@ -5,6 +5,7 @@ use super::*;
 
 /// Options of Algorithm A ([`omega_continuation`], [`omega_continuation_hex`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct OmegaOptions {
     /// `ω₀` in units of the mean measure (`ᾱ` or the mean tetrahedron Jacobian).
     pub omega0_rel: f64,
@@ -32,6 +33,43 @@ impl Default for OmegaOptions {
                 ..SolverOptions::default()
             },
         }
+    }
+}
+
+impl OmegaOptions {
+    /// Sets [`omega0_rel`](Self::omega0_rel).
+    #[must_use]
+    pub fn omega0_rel(mut self, omega0_rel: f64) -> Self {
+        self.omega0_rel = omega0_rel;
+        self
+    }
+
+    /// Sets [`omega_floor_rel`](Self::omega_floor_rel).
+    #[must_use]
+    pub fn omega_floor_rel(mut self, omega_floor_rel: f64) -> Self {
+        self.omega_floor_rel = omega_floor_rel;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps): ε of ε-convexity (`α₋ > ε·ᾱ`).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`refinement`](Self::refinement): run the refinement step after ε-convexity is reached.
+    #[must_use]
+    pub fn refinement(mut self, refinement: bool) -> Self {
+        self.refinement = refinement;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver).
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
     }
 }
 

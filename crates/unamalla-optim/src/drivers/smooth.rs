@@ -5,6 +5,7 @@ use super::*;
 
 /// The functional (and driver) of [`smooth`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum SmoothFunctional {
     /// `ao-homega`: [Méndez 2023, (6.8), (6.9)] with the ε-convexity guarantee
     /// ([`block_smoothing`]).
@@ -137,6 +138,7 @@ impl FromStr for SmoothFunctional {
 
 /// Options of [`smooth`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct SmoothOptions {
     /// The functional / driver.
     pub functional: SmoothFunctional,
@@ -205,6 +207,81 @@ impl SmoothOptions {
             schedule: self.schedule,
             stop_at_target: false,
         }
+    }
+
+    /// Sets [`functional`](Self::functional): the functional / driver.
+    #[must_use]
+    pub fn functional(mut self, functional: SmoothFunctional) -> Self {
+        self.functional = functional;
+        self
+    }
+
+    /// Sets [`solver`](Self::solver): the solver and its stopping options (every phase uses this
+    /// solver).
+    #[must_use]
+    pub fn solver(mut self, solver: SolverOptions) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// Sets [`eps`](Self::eps): ε of the ε-convexity target (`α₋ > ε·ᾱ`; adaptive-k uses
+    /// `k* = −ε`).
+    #[must_use]
+    pub fn eps(mut self, eps: f64) -> Self {
+        self.eps = eps;
+        self
+    }
+
+    /// Sets [`presmooth`](Self::presmooth): length pre-smoothing iterations (adaptive-k and
+    /// untangling; 0 = none).
+    #[must_use]
+    pub fn presmooth(mut self, presmooth: usize) -> Self {
+        self.presmooth = presmooth;
+        self
+    }
+
+    /// Sets [`iters_per_k`](Self::iters_per_k).
+    #[must_use]
+    pub fn iters_per_k(mut self, iters_per_k: usize) -> Self {
+        self.iters_per_k = iters_per_k;
+        self
+    }
+
+    /// Sets [`max_k_updates`](Self::max_k_updates): maximum `k` updates.
+    #[must_use]
+    pub fn max_k_updates(mut self, max_k_updates: usize) -> Self {
+        self.max_k_updates = max_k_updates;
+        self
+    }
+
+    /// Sets [`time_limit`](Self::time_limit).
+    #[must_use]
+    pub fn time_limit(mut self, time_limit: Option<f64>) -> Self {
+        self.time_limit = time_limit;
+        self
+    }
+
+    /// Sets [`sigma_continuation`](Self::sigma_continuation).
+    #[must_use]
+    pub fn sigma_continuation(mut self, sigma_continuation: Vec<f64>) -> Self {
+        self.sigma_continuation = sigma_continuation;
+        self
+    }
+
+    /// Sets [`continuation_iter`](Self::continuation_iter): iteration cap of each σ-continuation
+    /// stage (0 = 50).
+    #[must_use]
+    pub fn continuation_iter(mut self, continuation_iter: usize) -> Self {
+        self.continuation_iter = continuation_iter;
+        self
+    }
+
+    /// Sets [`schedule`](Self::schedule): the homotopy path of the adaptive pairs
+    /// ([`HomotopySchedule`]).
+    #[must_use]
+    pub fn schedule(mut self, schedule: HomotopySchedule) -> Self {
+        self.schedule = schedule;
+        self
     }
 }
 
@@ -328,6 +405,7 @@ where
 
 /// Which hexahedral driver [`smooth_hex`] runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum HexDriver {
     /// Algorithm A only.
     #[default]
@@ -338,6 +416,7 @@ pub enum HexDriver {
 
 /// Options of [`smooth_hex`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct HexSmoothOptions {
     /// Which algorithms.
     pub driver: HexDriver,
@@ -361,6 +440,36 @@ impl Default for HexSmoothOptions {
             },
             coplanarity: CoplanarityOptions::default(),
         }
+    }
+}
+
+impl HexSmoothOptions {
+    /// Sets [`driver`](Self::driver): which algorithms.
+    #[must_use]
+    pub fn driver(mut self, driver: HexDriver) -> Self {
+        self.driver = driver;
+        self
+    }
+
+    /// Sets [`scaling`](Self::scaling): tetrahedron scaling of `H_ω`.
+    #[must_use]
+    pub fn scaling(mut self, scaling: Scaling3) -> Self {
+        self.scaling = scaling;
+        self
+    }
+
+    /// Sets [`omega`](Self::omega).
+    #[must_use]
+    pub fn omega(mut self, omega: OmegaOptions) -> Self {
+        self.omega = omega;
+        self
+    }
+
+    /// Sets [`coplanarity`](Self::coplanarity): Algorithm B options.
+    #[must_use]
+    pub fn coplanarity(mut self, coplanarity: CoplanarityOptions) -> Self {
+        self.coplanarity = coplanarity;
+        self
     }
 }
 
