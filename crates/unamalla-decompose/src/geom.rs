@@ -509,12 +509,6 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        let rotated = |h: &[usize]| {
-            let k = (0..h.len()).min_by_key(|&k| h[k]).unwrap_or(0);
-            let mut h = h.to_vec();
-            h.rotate_left(k);
-            h
-        };
         let mut derived = 0;
         for _ in 0..2000 {
             let n = 5 + (next() * 40.0) as usize;
