@@ -8,6 +8,7 @@ use std::sync::{Arc, Mutex};
 
 use unamalla_mesh::{DVec2, Region};
 
+use super::Builder;
 use crate::builder::repair::RepairCache;
 use crate::concavity::{measures, Tolerances};
 use crate::corners::quad_fit;
@@ -15,8 +16,6 @@ use crate::decomposition::{Decomposition, Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::piece::{Piece, Ring, Tag};
 use crate::DecomposeOptions;
-
-use super::Builder;
 
 /// Results that the layouts of one region with one option set share (the rebuilds of
 /// [`chord_layout_cuts`](crate::chord_layout_cuts) after each round of arm cuts and each withdrawal differ from each

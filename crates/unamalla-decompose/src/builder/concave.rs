@@ -7,6 +7,8 @@ use rayon::prelude::*;
 
 use unamalla_mesh::DVec2;
 
+use super::run::Shape;
+use super::{beyond_best, Builder, Cand};
 use crate::concavity::measures_with_hull;
 use crate::corners::quad_fit_with_angles;
 use crate::geom::{
@@ -14,9 +16,6 @@ use crate::geom::{
     ring_angles_matched, total_key, visit_sorted,
 };
 use crate::piece::{End, Piece, Pos, Ring, Tag};
-
-use super::run::Shape;
-use super::{beyond_best, Builder, Cand};
 
 /// What trying a candidate cut of the concavity cut found: not admissible or a child too
 /// small (`Skipped`), or its score.

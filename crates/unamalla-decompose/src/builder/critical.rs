@@ -1,9 +1,8 @@
 //! Algorithm 4 ([Méndez 2023, §4.2.1]): a triangle cut off at a critical angle.
 
+use super::Builder;
 use crate::geom::ring_angle;
 use crate::piece::{End, Piece, Pos, Tag};
-
-use super::Builder;
 
 impl Builder<'_> {
     /// Algorithm 4: cut a triangle around the sharpest critical angle.

@@ -5,14 +5,13 @@ use std::f64::consts::PI;
 
 use unamalla_mesh::DVec2;
 
+use super::Builder;
 use crate::corners::{select_corners, triangle_rule, CornerWeights, TriangleBlock};
 use crate::decomposition::{Block, Cut, Decomposition, EdgeKind};
 use crate::error::DecomposeError;
 use crate::geom::ring_angle;
 use crate::piece::{Ring, Tag};
 use crate::DecomposeOptions;
-
-use super::Builder;
 
 impl Builder<'_> {
     /// Inserts `p` on edge `e` of block ring `bid`; if that edge is a cut, the point is also

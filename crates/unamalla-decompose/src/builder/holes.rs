@@ -5,11 +5,10 @@ use std::f64::consts::PI;
 
 use unamalla_mesh::DVec2;
 
+use super::{Builder, Cand};
 use crate::error::DecomposeError;
 use crate::geom::{perimeter, project_t};
 use crate::piece::{End, Piece, Pos, Tag};
-
-use super::{Builder, Cand};
 
 impl Builder<'_> {
     /// Algorithm 2: removes the hole nearest to the outer ring with two cuts.

@@ -1,10 +1,9 @@
 //! The cleanup (merge) pass: two blocks sharing one cut are merged when their union is
 //! approximately convex and its corners are no worse (crate documentation).
 
-use crate::piece::{Ring, Tag};
-
 use super::cache::MergeMemo;
 use super::Builder;
+use crate::piece::{Ring, Tag};
 
 impl Builder<'_> {
     /// The cleanup pass: removes every cut whose two blocks form a better block together.

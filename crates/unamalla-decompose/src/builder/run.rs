@@ -8,16 +8,15 @@ use rayon::prelude::*;
 
 use unamalla_mesh::DVec2;
 
+use super::cache::{
+    node_key, piece_key, renumber_piece, ChildRun, LeafRun, NodeRun, NodeSplit, NODE_RUN_MIN_LEN,
+};
+use super::Builder;
 use crate::concavity::concavity_with_hull;
 use crate::decomposition::{Step, TreeNode};
 use crate::error::DecomposeError;
 use crate::geom::{hull_from_order, hull_order, ring_angles, HullKey};
 use crate::piece::{Piece, Tag};
-
-use super::cache::{
-    node_key, piece_key, renumber_piece, ChildRun, LeafRun, NodeRun, NodeSplit, NODE_RUN_MIN_LEN,
-};
-use super::Builder;
 
 /// What Algorithm 1 computes of a ring before cutting it: the vertex angles, the points in
 /// hull order, the convex hull (and whether the points are pairwise different) and the

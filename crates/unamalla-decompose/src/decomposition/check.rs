@@ -8,10 +8,9 @@ use rayon::prelude::*;
 use unamalla_mesh::geometry::{open_segment_hits, point_segment_distance};
 use unamalla_mesh::{DVec2, Region, SegmentIndex};
 
+use super::{Block, Cut, EdgeKind};
 use crate::error::DecomposeError;
 use crate::geom::{ring_angle, signed_area};
-
-use super::{Block, Cut, EdgeKind};
 
 /// Absolute tolerance for "lies on the region boundary": 1e-9 of the bounding-box diagonal.
 pub(crate) fn boundary_tol(region: &Region) -> f64 {

@@ -3,11 +3,10 @@
 
 use unamalla_mesh::DVec2;
 
-use crate::builder::Builder;
-use crate::piece::{Ring, Tag};
-
 use super::merge::Host;
 use super::{Merge, Resplit, Split, TMP_CUT, TMP_CUT2};
+use crate::builder::Builder;
+use crate::piece::{Ring, Tag};
 
 /// What one repair attempt of a block found (steps 1–3 of [`Builder::repair_pass`]).
 #[derive(Clone)]

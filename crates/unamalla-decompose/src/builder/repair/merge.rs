@@ -3,12 +3,11 @@
 
 use rayon::prelude::*;
 
-use crate::builder::Builder;
-use crate::piece::{Ring, Tag};
-
 use super::cache::{host_key, relabel_resplits, FitMemo};
 use super::table::CutTable;
 use super::{as_first_cut, beats, ring_key, union_ring, Merge, Resplit, Split, RESPLIT_SLACK};
+use crate::builder::Builder;
+use crate::piece::{Ring, Tag};
 
 /// The neighbourhood of a block that a repair attempt reads: block slot `k`, the blocks
 /// across its cuts and the blocks across theirs (rings, tags, and whether those cuts are

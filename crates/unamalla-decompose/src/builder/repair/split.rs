@@ -7,13 +7,12 @@ use rayon::prelude::*;
 use unamalla_mesh::geometry::open_segment_hits;
 use unamalla_mesh::DVec2;
 
+use super::table::{ChildScreen, CutTable};
+use super::{as_first_cut, retag, Resplit, Split, TMP_CUT, TMP_IDS};
 use crate::builder::{beyond_best, Builder};
 use crate::decomposition::{Step, TreeNode};
 use crate::geom::{total_key, visit_sorted};
 use crate::piece::{End, Piece, Pos, Ring, Tag};
-
-use super::table::{ChildScreen, CutTable};
-use super::{as_first_cut, retag, Resplit, Split, TMP_CUT, TMP_IDS};
 
 impl Builder<'_> {
     /// The best cut splitting `ring` into two good blocks.
