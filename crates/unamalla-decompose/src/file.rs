@@ -41,7 +41,8 @@
 use serde::{Deserialize, Serialize};
 use unamalla_mesh::{DVec2, Region};
 
-use crate::auto::{choose_corners, Applied, Builder, DecomposeOptions};
+use crate::auto::DecomposeOptions;
+use crate::builder::{choose_corners, Applied, Builder};
 use crate::decomposition::{
     boundary_tol, check_corners, check_cuts, classify, Block, Cut, Decomposition, EdgeKind, Step,
     TreeNode,

@@ -109,7 +109,7 @@
 //! merged away. The tree T keeps the split history; its leaves point to the block containing
 //! them.
 //!
-//! **Corner repair** (beyond the thesis, module `repair`): after the merge pass, a block with
+//! **Corner repair** (beyond the thesis, module `builder::repair`): after the merge pass, a block with
 //! fewer than four *usable* corners (interior angle < 170°), a critical angle or a non-convex
 //! shape is split by one more cut into two good blocks, or merged with a neighbour (and the
 //! union re-split), so that the shared cut meets the boundary at a better angle; failing that,
@@ -198,6 +198,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod auto;
+mod builder;
 pub mod chords;
 pub mod concavity;
 pub mod corners;
@@ -209,7 +210,6 @@ pub mod file;
 mod geom;
 mod piece;
 mod render;
-mod repair;
 pub mod submap;
 
 pub use auto::{

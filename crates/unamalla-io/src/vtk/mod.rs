@@ -50,7 +50,9 @@
 //! errors with 1-based line numbers; the reader never panics and never trusts a declared count
 //! for a large allocation.
 
+mod lexer;
 mod read;
+mod sections;
 mod write;
 
 pub use read::{parse_vtk, read_vtk, VtkFile, VtkMesh};
