@@ -6,8 +6,11 @@ use unamalla_mesh::{DVec2, Region};
 
 /// The thesis's layout (Algorithm 1 alone): these known answers are the thesis's
 /// (the chord layout, the default, may cut a triangle or a strip across first).
+/// The thesis's rules: the concavity layout, critical triangle vertices blunted.
 fn thesis() -> DecomposeOptions {
-    DecomposeOptions::default().layout(unamalla_decompose::Layout::Concavity)
+    DecomposeOptions::default()
+        .layout(unamalla_decompose::Layout::Concavity)
+        .blunt_critical_tips(true)
 }
 
 fn v(x: f64, y: f64) -> DVec2 {
@@ -189,6 +192,39 @@ fn thesis_triangle_24_78_78() {
 #[test]
 fn thesis_triangle_15_20_145() {
     assert_triangle_block((15.0, 20.0), &[0, 1]);
+}
+
+/// The default triangle-block rule: every vertex is a corner, critical or not, and the fourth
+/// corner is the midpoint of the longest side (the side opposite the largest angle), a point
+/// inserted on it: a ring of 4 points.
+fn assert_sharp_tips_are_corners(angles: (f64, f64), longest: (usize, usize)) {
+    let t = triangle(angles.0, angles.1);
+    let r = Region::new(t.clone(), vec![]).unwrap();
+    let opts = DecomposeOptions::default().layout(unamalla_decompose::Layout::Concavity);
+    let d = decompose(&r, &opts).unwrap();
+    assert_eq!(d.blocks.len(), 1, "a triangle is a leaf");
+    let b = &d.blocks[0];
+    assert!(b.triangle);
+    assert_eq!(b.ring.len(), 4);
+    let got: Vec<DVec2> = b.corners.iter().map(|&k| b.ring[k]).collect();
+    let mid = 0.5 * (t[longest.0] + t[longest.1]);
+    for e in [t[0], t[1], t[2], mid] {
+        assert!(
+            got.iter().any(|g| g.distance(e) < 1e-12),
+            "expected corner {e} in {got:?}"
+        );
+    }
+    check_tiling(&r, &d);
+}
+
+#[test]
+fn a_sharp_tip_is_a_corner_by_default() {
+    // 28° at vertex 2 is critical; the largest angle, 102°, is at the origin: the longest
+    // side joins vertices 1 and 2
+    assert_sharp_tips_are_corners((102.0, 50.0), (1, 2));
+    // 15° and 20° (both critical) at vertices 0 and 1, 145° at vertex 2: the longest side
+    // joins vertices 0 and 1
+    assert_sharp_tips_are_corners((15.0, 20.0), (0, 1));
 }
 
 fn rhombus_with_three_holes() -> Region {

@@ -263,10 +263,11 @@ fn is_triangle_like(ring: &[DVec2], w: &CornerWeights) -> bool {
 /// `None` when the block is not triangle-like or takes its corners among four non-reflex
 /// vertices instead.
 ///
-/// Points are inserted on original-boundary edges only if possible; a three-corner block
-/// keeps its critical vertex as a corner and gets its fourth corner on the boundary; only
-/// when neither works is a point put inside a cut (the repair pass, module `repair`, removes
-/// every such block it can before this runs).
+/// Points are inserted on original-boundary edges only if possible; a critical vertex is a
+/// corner unless [`DecomposeOptions::blunt_critical_tips`] asks for the two inserted points
+/// beside it; a three-corner block keeps its critical vertex as a corner and gets its fourth
+/// corner on the boundary; only when neither works is a point put inside a cut (the repair
+/// pass, module `repair`, removes every such block it can before this runs).
 pub(crate) fn triangle_plan(
     ring: &Ring,
     theta: f64,
@@ -279,7 +280,7 @@ pub(crate) fn triangle_plan(
     let tags = &ring.tags;
     let boundary_only = |e: usize| matches!(tags.get(e), Some(Tag::Boundary(_)));
     let frac = opts.triangle_insert_fraction;
-    if let Some(t) = triangle_rule(pts, theta, frac, &boundary_only) {
+    if let Some(t) = triangle_rule(pts, tip_angle(opts, theta), frac, &boundary_only) {
         return Some((t, false));
     }
     // with four non-reflex vertices, phase B picks corners among them instead
@@ -303,6 +304,17 @@ pub(crate) fn needs_cut_point(ring: &Ring, theta: f64, opts: &DecomposeOptions) 
     triangle_plan(ring, theta, opts).is_some_and(|(_, in_cut)| in_cut)
 }
 
+/// The critical angle the triangle-block rule blunts below: θ₋ with
+/// [`DecomposeOptions::blunt_critical_tips`], else 0 (no vertex is blunted: a sharp vertex
+/// stays a corner).
+fn tip_angle(opts: &DecomposeOptions, theta_minus: f64) -> f64 {
+    if opts.blunt_critical_tips {
+        theta_minus
+    } else {
+        0.0
+    }
+}
+
 /// A block's (possibly extended) ring, its edge bookkeeping, corners and triangle flag.
 pub(crate) type CornerChoice = (Vec<DVec2>, Vec<EdgeKind>, [usize; 4], bool);
 
@@ -321,9 +333,12 @@ pub(crate) fn choose_corners(
         .count();
     if n == 3 || strong < 4 {
         let can = |e: usize| matches!(edges[e], EdgeKind::Boundary { .. });
-        if let Some((pts, origin, corners)) =
-            triangle_rule(ring, theta_minus, opts.triangle_insert_fraction, &can)
-        {
+        if let Some((pts, origin, corners)) = triangle_rule(
+            ring,
+            tip_angle(opts, theta_minus),
+            opts.triangle_insert_fraction,
+            &can,
+        ) {
             // edge k describes pts[k] → pts[k+1]: an old vertex i starts a piece of old edge i,
             // an inserted point on edge e continues old edge e.
             let mut fixed = Vec::with_capacity(pts.len());
