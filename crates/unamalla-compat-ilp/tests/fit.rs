@@ -2,6 +2,8 @@
 //! the MILP path on a non-network system and the comparison with the lower-bound solver (5.10).
 //! Feasibility is checked here from the definition of (5.1)–(5.3), not with the crate's assembly.
 
+mod common;
+use common::build;
 use proptest::prelude::*;
 use unamalla_compat_ilp::fixtures::{grid_decomposition, thesis_example_5_1};
 use unamalla_compat_ilp::{
@@ -241,40 +243,6 @@ fn grid_fits_are_certified_and_closer_to_the_area_than_the_lower_bounds() {
     }
 }
 
-/// Small random problems: `nblocks` blocks, sides split into two curves where `doubled` says so,
-/// cut pairs from `cut_picks` (curves of different sides, each curve in at most one cut).
-fn build(
-    nblocks: usize,
-    doubled: &[usize],
-    lengths: &[f64],
-    cut_picks: &[(usize, usize)],
-) -> CompatProblem {
-    let mut next = 0usize;
-    let mut blocks = Vec::new();
-    for k in 0..nblocks {
-        let mut sides: [Vec<usize>; 4] = Default::default();
-        for (s, side) in sides.iter_mut().enumerate() {
-            let n = if doubled.contains(&(4 * k + s)) { 2 } else { 1 };
-            *side = (next..next + n).collect();
-            next += n;
-        }
-        blocks.push(Block { id: k + 1, sides });
-    }
-    let p = next;
-    let curves = (0..p).map(|j| Curve::new(j + 1, lengths[j])).collect();
-    let mut used = vec![false; p];
-    let mut cuts = Vec::new();
-    for &(a, b) in cut_picks {
-        let (a, b) = (a % p, b % p);
-        if a != b && !used[a] && !used[b] {
-            used[a] = true;
-            used[b] = true;
-            cuts.push(CutPair::new(a, b));
-        }
-    }
-    CompatProblem::new(curves, blocks, cuts)
-}
-
 /// The minimum of the fit cost over every feasible assignment with counts in `2..=hi`
 /// (cut copies enumerated as one value), or `None` when there is none.
 fn exhaustive(p: &CompatProblem, t: &FitTargets, hi: usize) -> Option<u128> {
@@ -324,7 +292,7 @@ proptest! {
         cut_picks in proptest::collection::vec((0usize..10, 0usize..10), 0..3),
         minimum in (0usize..10, 2usize..5),
     ) {
-        let p = build(nblocks, &doubled, &lengths, &cut_picks);
+        let p = build(nblocks, &doubled, &lengths, &cut_picks, &[]);
         let classes = p.curves.len() - p.cuts.len();
         prop_assume!(classes <= 7);
         let hi = 8;

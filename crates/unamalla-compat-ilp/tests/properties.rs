@@ -3,51 +3,10 @@
 //! compared with a brute-force enumeration on small cases.
 
 use proptest::prelude::*;
+mod common;
+use common::build;
 use unamalla_compat_ilp::fixtures::grid_decomposition;
-use unamalla_compat_ilp::{
-    solve, Block, CompatError, CompatProblem, Curve, CutPair, Method, Optimality, SolveOptions,
-};
-
-/// Build a small decomposition from raw random choices.
-fn build(
-    nblocks: usize,
-    doubled: &[usize],
-    lengths: &[f64],
-    cut_picks: &[(usize, usize)],
-    pins: &[Option<usize>],
-) -> CompatProblem {
-    let mut next = 0usize;
-    let mut blocks = Vec::new();
-    for k in 0..nblocks {
-        let mut sides: [Vec<usize>; 4] = Default::default();
-        for (s, side) in sides.iter_mut().enumerate() {
-            let n = if doubled.contains(&(4 * k + s)) { 2 } else { 1 };
-            *side = (next..next + n).collect();
-            next += n;
-        }
-        blocks.push(Block { id: k + 1, sides });
-    }
-    let p = next;
-    let curves: Vec<Curve> = (0..p)
-        .map(|j| Curve {
-            id: j + 1,
-            length: lengths[j],
-            pinned: pins[j],
-            label: None,
-        })
-        .collect();
-    let mut used = vec![false; p];
-    let mut cuts = Vec::new();
-    for &(a, b) in cut_picks {
-        let (a, b) = (a % p, b % p);
-        if a != b && !used[a] && !used[b] {
-            used[a] = true;
-            used[b] = true;
-            cuts.push(CutPair::new(a, b));
-        }
-    }
-    CompatProblem::new(curves, blocks, cuts)
-}
+use unamalla_compat_ilp::{solve, CompatError, CompatProblem, Method, Optimality, SolveOptions};
 
 /// Lower bounds computed independently from the definition `max(2, d·⌈ℓ/ℓ_min⌉)`.
 fn bounds(p: &CompatProblem, d: usize) -> Vec<i64> {

@@ -33,6 +33,10 @@ use std::path::PathBuf;
 use unamalla_contour::{remove_features_below, simplify_region, Method, Preset, SimplifyOptions};
 use unamalla_mesh::{DVec2, Region};
 
+#[path = "common/bench_ring.rs"]
+mod bench_ring;
+use bench_ring::ring as bench_ring;
+
 fn fixtures_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/regions")
 }
@@ -104,22 +108,6 @@ fn random_region(seed: u64) -> Region {
         })
         .collect();
     Region::new(outer, holes).unwrap()
-}
-
-/// The benchmark ring of `benches/simplify.rs` with `n` vertices.
-fn bench_ring(n: usize) -> Vec<DVec2> {
-    let mut s = 0x9E37_79B9_7F4A_7C15u64;
-    (0..n)
-        .map(|k| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let noise = ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02;
-            let t = std::f64::consts::TAU * k as f64 / n as f64;
-            let r = 1000.0 * (1.0 + 0.25 * (7.0 * t).sin() + 0.1 * (23.0 * t).cos()) + noise;
-            DVec2::new(r * t.cos(), r * t.sin())
-        })
-        .collect()
 }
 
 fn fnv(region: &Region) -> u64 {
