@@ -90,7 +90,7 @@ impl HexFunctional {
     }
 }
 
-pub(super) fn check_pos(name: &'static str, v: f64) -> Result<f64, FunctionalError> {
+fn check_pos(name: &'static str, v: f64) -> Result<f64, FunctionalError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
@@ -102,7 +102,7 @@ pub(super) fn check_pos(name: &'static str, v: f64) -> Result<f64, FunctionalErr
     }
 }
 
-pub(super) fn check_finite(name: &'static str, v: f64) -> Result<f64, FunctionalError> {
+fn check_finite(name: &'static str, v: f64) -> Result<f64, FunctionalError> {
     if v.is_finite() {
         Ok(v)
     } else {

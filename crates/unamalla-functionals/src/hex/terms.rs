@@ -14,9 +14,9 @@ pub(super) struct ScaledTet {
     pub(super) nodes: [usize; 4],
     pub(super) w: [[f64; 4]; 3],
     /// `gram[j][l] = Σ_a w_aj w_al`.
-    pub(super) gram: [[f64; 4]; 4],
+    gram: [[f64; 4]; 4],
     /// `wx[j][l] = w_j × w_l` with `w_j = (w_0j, w_1j, w_2j)`.
-    pub(super) wx: [[DVec3; 4]; 4],
+    wx: [[DVec3; 4]; 4],
 }
 
 impl ScaledTet {
@@ -38,7 +38,7 @@ pub(super) type CellBlocks = [[[f64; 9]; 8]; 8];
 /// Adds the 3×3 block `blk` at `(a, b)` and its transpose at `(b, a)` (once if `a == b`; the
 /// diagonal blocks built here are symmetric).
 #[inline(always)]
-pub(super) fn add_block_sym(hb: &mut CellBlocks, a: usize, b: usize, blk: &[f64; 9]) {
+fn add_block_sym(hb: &mut CellBlocks, a: usize, b: usize, blk: &[f64; 9]) {
     if a == b {
         for (o, v) in hb[a][a].iter_mut().zip(blk) {
             *o += v;
@@ -55,13 +55,13 @@ pub(super) fn add_block_sym(hb: &mut CellBlocks, a: usize, b: usize, blk: &[f64;
 
 /// `M(w)_{ij} = ε_{ijk} w_k`.
 #[inline(always)]
-pub(super) fn eps_mat(w: DVec3) -> [[f64; 3]; 3] {
+fn eps_mat(w: DVec3) -> [[f64; 3]; 3] {
     [[0.0, w.z, -w.y], [-w.z, 0.0, w.x], [w.y, -w.x, 0.0]]
 }
 
 /// Hessian blocks of `det[c₀, c₁, c₂]`: `[a][b] = ε_{abc} M(c_c)`.
 #[inline(always)]
-pub(super) fn det_hess(c: &[DVec3; 3]) -> [[[[f64; 3]; 3]; 3]; 3] {
+fn det_hess(c: &[DVec3; 3]) -> [[[[f64; 3]; 3]; 3]; 3] {
     let mut h = [[[[0.0; 3]; 3]; 3]; 3];
     let m0 = eps_mat(c[0]);
     let m1 = eps_mat(c[1]);
@@ -309,12 +309,12 @@ pub(super) fn face_term_blocks(
 }
 
 /// Leg-Hessian blocks `h[k][l]` (3×3) of a face term w.r.t. its legs `B−A, D−A, C−A`.
-pub(super) type LegHess = [[[[f64; 3]; 3]; 3]; 3];
+type LegHess = [[[[f64; 3]; 3]; 3]; 3];
 
 /// Value, leg gradients (w.r.t. `B−A, D−A, C−A`) and, with `want_h`, leg Hessian of the face
 /// term `C·k²` of the hex-local face `f`; `None` for a degenerate face (`n₂w₂ = 0`).
 #[inline(always)]
-pub(super) fn face_parts(
+fn face_parts(
     f: [usize; 4],
     p: &[DVec3; 8],
     cpen: f64,

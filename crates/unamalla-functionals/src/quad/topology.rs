@@ -39,7 +39,7 @@ pub struct QuadTopology {
     /// entries in the schedule order (store, don't add; see [`lanes`]).
     pub(super) gfirst: Vec<u8>,
     /// Free variable nodes in no cell (their gradient entries are zeroed explicitly).
-    pub(super) isolated: Vec<u32>,
+    isolated: Vec<u32>,
     /// Per cell, entry `4i + j`: position of vertex `j` in the neighbour list of vertex `i`
     /// (the CSR slot of block `(i, j)`), with [`lanes::SLOT_FIRST`] on the first contribution;
     /// built on the first Hessian refresh. `None` if a neighbour list is too long for `u16`

@@ -11,9 +11,9 @@ use unamalla_mesh::{DVec2, QuadMesh, Region, SegmentIndex};
 pub(super) struct Ring {
     pub(super) pts: Vec<DVec2>,
     /// `cum[i]`: arc length from vertex 0 to vertex `i`; `cum[n]` = perimeter.
-    pub(super) cum: Vec<f64>,
+    cum: Vec<f64>,
     /// Arc positions of the feature vertices, increasing.
-    pub(super) features: Vec<f64>,
+    features: Vec<f64>,
 }
 
 impl Ring {

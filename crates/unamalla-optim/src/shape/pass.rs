@@ -22,9 +22,9 @@ pub(super) struct Local {
     /// `Σ (τ − μ)₊²` over the node's cells.
     pub(super) phi: f64,
     /// Smallest μ over the node's cells.
-    pub(super) min_mu: f64,
+    min_mu: f64,
     /// Smallest corner α over the node's cells.
-    pub(super) min_alpha: f64,
+    min_alpha: f64,
     /// Bit `k`: the node's `k`-th cell has μ ≥ keep.
     pub(super) good: u64,
 }
@@ -37,19 +37,19 @@ pub(super) struct Pass<'a> {
     pub(super) cells: &'a [[usize; 4]],
     /// Cell ids around each node (CSR: `adj[start[v]..start[v + 1]]`, in cell order).
     pub(super) start: Vec<usize>,
-    pub(super) adj: Vec<usize>,
+    adj: Vec<usize>,
     /// Orientation sign of the mesh (+1: counter-clockwise cells).
-    pub(super) sign: f64,
+    sign: f64,
     pub(super) opts: &'a ShapeOptions,
     /// Guard 1's `ε·ᾱ`.
-    pub(super) alpha_floor: f64,
+    alpha_floor: f64,
     /// The region's ring edges (guard 3), when a region is known.
     pub(super) index: Option<&'a SegmentIndex>,
     /// Cells with a fixed node (only their centroids can cross the boundary when an interior
     /// node moves).
-    pub(super) touches: Vec<bool>,
+    touches: Vec<bool>,
     /// Guard 4: the sum of the four corner α (four times the area) of every cell at the start.
-    pub(super) area0: Vec<f64>,
+    area0: Vec<f64>,
 }
 
 impl<'a> Pass<'a> {
@@ -189,7 +189,7 @@ impl<'a> Pass<'a> {
 
     /// Guards 1–2 of a candidate against the node's state `old`, and whether it improves on
     /// `best` (lower `Φ`, ties broken by a larger smallest μ).
-    pub(super) fn better(&self, old: &Local, best: &Local, cand: Option<Local>) -> Option<Local> {
+    fn better(&self, old: &Local, best: &Local, cand: Option<Local>) -> Option<Local> {
         let c = cand?;
         if c.min_alpha < old.min_alpha.min(self.alpha_floor) {
             return None;
