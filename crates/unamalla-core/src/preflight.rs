@@ -237,7 +237,7 @@ fn failures_next_to_holes(cells: &[Vec<DVec2>], region: &Region, h: f64) -> Vec<
     count
 }
 
-/// The holes of `region` narrower than `max_width` (the [`hole_width`] of the narrow-hole
+/// The holes of `region` narrower than `max_width` (the `hole_width` of the narrow-hole
 /// retry) that are the nearest hole, within `h`, of a cell the verification `v` lists as
 /// failing; in increasing order. What the later rounds of the narrow-hole retry of
 /// [`crate::Mesher::mesh_observed`] leave out.
