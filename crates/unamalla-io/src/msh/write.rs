@@ -3,7 +3,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use unamalla_mesh::{BlockMesh2, DVec3, HasHexCells, HasNodes, HasQuadCells};
+use unamalla_mesh::{BlockMesh2, DVec3, HasHexCells, HasQuadCells};
 
 use super::{EdgeGroup, FaceGroup, MSH_HEX, MSH_LINE, MSH_QUAD};
 use crate::atomic::atomic_write;
@@ -54,7 +54,19 @@ pub fn write_msh_quads<M: HasQuadCells + ?Sized>(
     domain: &str,
     groups: &[EdgeGroup],
 ) -> Result<(), IoError> {
-    let path = path.as_ref();
+    write_quads_in_parts(path.as_ref(), mesh, &[], domain, groups)
+}
+
+/// The quad writer of [`write_msh_quads`] and [`write_msh_blocks`]: the names and node ids
+/// checked, the nodes lifted to z = 0, the cells in `parts` consecutive entities (all in one
+/// when `parts` is empty).
+fn write_quads_in_parts<M: HasQuadCells + ?Sized>(
+    path: &Path,
+    mesh: &M,
+    parts: &[usize],
+    domain: &str,
+    groups: &[EdgeGroup],
+) -> Result<(), IoError> {
     let nn = mesh.num_nodes();
     let mut seen = Vec::new();
     check_name(path, domain, &mut seen)?;
@@ -80,7 +92,7 @@ pub fn write_msh_quads<M: HasQuadCells + ?Sized>(
         })
         .collect();
     atomic_write(path, |w| {
-        write_msh(w, 2, &nodes, &cells, &[], MSH_QUAD, domain, &gs, MSH_LINE)
+        write_msh(w, 2, &nodes, &cells, parts, MSH_QUAD, domain, &gs, MSH_LINE)
     })
 }
 
@@ -96,38 +108,8 @@ pub fn write_msh_blocks(
     domain: &str,
     groups: &[EdgeGroup],
 ) -> Result<(), IoError> {
-    let path = path.as_ref();
-    let global = mesh.global();
-    let nn = global.num_nodes();
-    let mut seen = Vec::new();
-    check_name(path, domain, &mut seen)?;
-    for g in groups {
-        check_name(path, &g.name, &mut seen)?;
-        check_ids(path, &g.name, &g.edges, nn)?;
-    }
-    let nodes: Vec<DVec3> = global
-        .nodes()
-        .iter()
-        .map(|p| DVec3::new(p.x, p.y, 0.0))
-        .collect();
-    let cells: Vec<Vec<usize>> = (0..global.num_quads())
-        .map(|c| global.quad(c).to_vec())
-        .collect();
     let parts: Vec<usize> = mesh.blocks().iter().map(|b| b.num_quads()).collect();
-    let gs: Vec<(&str, Vec<Vec<usize>>)> = groups
-        .iter()
-        .map(|g| {
-            (
-                g.name.as_str(),
-                g.edges.iter().map(|e| e.to_vec()).collect(),
-            )
-        })
-        .collect();
-    atomic_write(path, |w| {
-        write_msh(
-            w, 2, &nodes, &cells, &parts, MSH_QUAD, domain, &gs, MSH_LINE,
-        )
-    })
+    write_quads_in_parts(path.as_ref(), mesh.global(), &parts, domain, groups)
 }
 
 /// Writes a hex mesh (any [`HasHexCells`]) as MSH 4.1 with the cells in the physical group
