@@ -73,6 +73,32 @@ impl<'a> Lexer<'a> {
         Some((l, self.line()))
     }
 
+    /// The file the text comes from (for error values built outside the lexer).
+    pub(crate) fn path(&self) -> &'a Path {
+        self.path
+    }
+
+    /// The next token without consuming it.
+    pub(crate) fn peek(&mut self) -> Option<(&'a str, usize)> {
+        if self.peeked.is_none() {
+            self.peeked = self.next();
+        }
+        self.peeked
+    }
+
+    /// Drops the rest of the current line and everything up to and including the next blank
+    /// line (VTK 5 `METADATA` blocks end with a blank line).
+    pub(crate) fn skip_block_to_blank_line(&mut self) {
+        self.peeked = None;
+        self.cur = "".split_whitespace();
+        for (k, l) in self.lines.by_ref() {
+            self.line = k + 1;
+            if l.trim().is_empty() {
+                break;
+            }
+        }
+    }
+
     pub(crate) fn next(&mut self) -> Option<(&'a str, usize)> {
         if let Some(t) = self.peeked.take() {
             return Some(t);
@@ -141,6 +167,24 @@ impl<'a> Lexer<'a> {
                     format!("{what}: expected a finite number, found {t:?}"),
                 )
             })
+    }
+
+    /// Any number of Rust's `f64` grammar, `nan` and `inf` included (data arrays of VTK files
+    /// may hold them; the readers check coordinates themselves), unlike [`f64`](Self::f64).
+    pub(crate) fn number(&mut self, what: &str) -> Result<(f64, usize), IoError> {
+        let (t, line) = self.token(what)?;
+        t.parse::<f64>()
+            .map(|v| (v, line))
+            .map_err(|_| self.malformed(line, format!("{what}: expected a number, found {t:?}")))
+    }
+
+    /// Reads `count` values with [`number`](Self::number).
+    pub(crate) fn numbers(&mut self, count: usize, what: &str) -> Result<Vec<f64>, IoError> {
+        let mut v = Vec::with_capacity(count.min(MAX_PREALLOC));
+        for _ in 0..count {
+            v.push(self.number(what)?.0);
+        }
+        Ok(v)
     }
 
     /// `a * b` or a "count too large" error.

@@ -50,7 +50,6 @@
 //! errors with 1-based line numbers; the reader never panics and never trusts a declared count
 //! for a large allocation.
 
-mod lexer;
 mod read;
 mod sections;
 mod write;

@@ -4,7 +4,6 @@ use std::path::Path;
 
 use unamalla_mesh::{DVec2, HexMesh, QuadMesh, StructuredGrid2, StructuredGrid3};
 
-use super::lexer::Lexer;
 use super::sections::{
     read_attribute, read_cell_types, read_cells, read_field, read_points, Arrays, Attr, CellTypes,
     Cells, Dataset, Points,
@@ -12,6 +11,7 @@ use super::sections::{
 use super::write::VTK_QUAD;
 use crate::error::IoError;
 use crate::geojson::STRING_SOURCE;
+use crate::lex::Lexer;
 
 /// The mesh stored in a VTK file.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,7 +124,7 @@ fn parse_at(text: &str, path: &Path) -> Result<VtkFile, IoError> {
     let mut lx = Lexer::new(text, path);
 
     // Header: version line, title line, ASCII.
-    let (first, line) = lx.raw_line().ok_or_else(|| IoError::Truncated {
+    let (first, line) = lx.next_line().ok_or_else(|| IoError::Truncated {
         path: path.to_path_buf(),
         line: 1,
         expected: "the \"# vtk DataFile Version\" header".into(),
@@ -140,13 +140,13 @@ fn parse_at(text: &str, path: &Path) -> Result<VtkFile, IoError> {
             format!("expected \"# vtk DataFile Version x.y\", found {first:?}"),
         ));
     }
-    let (title, _) = lx.raw_line().ok_or_else(|| IoError::Truncated {
+    let (title, _) = lx.next_line().ok_or_else(|| IoError::Truncated {
         path: path.to_path_buf(),
         line: 1,
         expected: "the title line".into(),
     })?;
     let title = title.trim_end().to_string();
-    let (fmt, line) = lx.raw_line().ok_or_else(|| IoError::Truncated {
+    let (fmt, line) = lx.next_line().ok_or_else(|| IoError::Truncated {
         path: path.to_path_buf(),
         line: 2,
         expected: "ASCII".into(),
@@ -291,7 +291,7 @@ fn parse_at(text: &str, path: &Path) -> Result<VtkFile, IoError> {
         }
     }
 
-    let end_line = lx.line.max(1);
+    let end_line = lx.line();
     let points = points.ok_or_else(|| IoError::Truncated {
         path: path.to_path_buf(),
         line: end_line,

@@ -3,10 +3,10 @@
 
 use unamalla_mesh::DVec3;
 
-use super::lexer::{Lexer, MAX_PREALLOC};
 use super::read::count_mismatch;
 use super::write::{VTK_HEXAHEDRON, VTK_QUAD};
 use crate::error::IoError;
+use crate::lex::{Lexer, MAX_PREALLOC};
 
 /// Named data arrays in file order.
 pub(super) type Arrays = Vec<(String, Vec<f64>)>;
@@ -54,9 +54,9 @@ pub(super) fn read_points(lx: &mut Lexer<'_>, line: usize) -> Result<Points, IoE
     let mut nodes = Vec::with_capacity(n.min(MAX_PREALLOC));
     let mut first_nonzero_z = None;
     for v in 0..n {
-        let (x, _) = lx.f64("point x")?;
-        let (y, _) = lx.f64("point y")?;
-        let (z, zline) = lx.f64("point z")?;
+        let (x, _) = lx.number("point x")?;
+        let (y, _) = lx.number("point y")?;
+        let (z, zline) = lx.number("point z")?;
         if z != 0.0 && first_nonzero_z.is_none() {
             first_nonzero_z = Some((v, zline, z));
         }
@@ -80,7 +80,7 @@ pub(super) fn read_points(lx: &mut Lexer<'_>, line: usize) -> Result<Points, IoE
 pub(super) fn read_cells(lx: &mut Lexer<'_>, header_line: usize) -> Result<Cells, IoError> {
     let (n, _) = lx.usize("CELLS count")?;
     let (size, _) = lx.usize("CELLS size")?;
-    let path = lx.path;
+    let path = lx.path();
     if lx
         .peek()
         .is_some_and(|(t, _)| t.eq_ignore_ascii_case("OFFSETS"))
