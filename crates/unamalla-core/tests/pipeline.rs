@@ -202,3 +202,64 @@ fn every_bundled_region_meets_the_quality_targets() {
         assert!(rep.seconds < 30.0, "{name}: {} s", rep.seconds);
     }
 }
+
+/// A square with a 33.4° spike (tip at (15, 5), base from (10, 3.5) to (10, 6.5)): a critical
+/// angle (below θ₋ = 40°), so the decomposition gives the spike a triangle block. By default the
+/// tip is a block corner, so exactly one cell has the tip node, with the whole angle; the
+/// thesis's rule (`blunt_critical_tips`) puts the tip inside a short side, shared by two cells
+/// of about half the angle each.
+#[test]
+fn a_sharp_tip_is_one_cell_by_default_and_two_half_cells_when_blunted() {
+    use unamalla_core::decompose::DecomposeOptions;
+    use unamalla_core::mesh::DVec2;
+    let v = DVec2::new;
+    let region = Region::new(
+        vec![
+            v(0.0, 0.0),
+            v(10.0, 0.0),
+            v(10.0, 3.5),
+            v(15.0, 5.0),
+            v(10.0, 6.5),
+            v(10.0, 10.0),
+            v(0.0, 10.0),
+        ],
+        vec![],
+    )
+    .unwrap();
+    let tip = v(15.0, 5.0);
+    let tip_angle = 2.0 * (1.5f64 / 5.0).atan();
+    // the cells having the tip as a node, and their angles there
+    let at_tip = |r: &MeshResult| -> Vec<f64> {
+        let g = r.mesh.global();
+        let node = (0..g.num_nodes())
+            .find(|&k| g.nodes()[k].distance(tip) < 1e-9)
+            .expect("the tip is a mesh node");
+        (0..g.num_quads())
+            .filter_map(|c| {
+                let q = g.quad(c);
+                let i = q.iter().position(|&n| n == node)?;
+                let p = g.nodes()[node];
+                let a = g.nodes()[q[(i + 3) % 4]] - p;
+                let b = g.nodes()[q[(i + 1) % 4]] - p;
+                Some(a.angle_to(b).abs())
+            })
+            .collect()
+    };
+    let corner = Mesher::new().cells(2000).mesh(&region).unwrap();
+    check(&corner, 0);
+    let cells = at_tip(&corner);
+    assert_eq!(cells.len(), 1, "{cells:?}");
+    assert!(
+        (cells[0] - tip_angle).abs() < 1e-9,
+        "{cells:?} vs {tip_angle}"
+    );
+    let blunt = Mesher::new()
+        .cells(2000)
+        .decompose_options(DecomposeOptions::default().blunt_critical_tips(true))
+        .mesh(&region)
+        .unwrap();
+    let cells = at_tip(&blunt);
+    assert_eq!(cells.len(), 2, "{cells:?}");
+    assert!((cells[0] + cells[1] - tip_angle).abs() < 1e-9, "{cells:?}");
+    assert!(cells.iter().all(|&a| a < 0.75 * tip_angle), "{cells:?}");
+}
