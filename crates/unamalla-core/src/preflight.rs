@@ -237,15 +237,16 @@ fn failures_next_to_holes(cells: &[Vec<DVec2>], region: &Region, h: f64) -> Vec<
     count
 }
 
-/// The holes of `region` narrower than `max_width` (the `hole_width` of the narrow-hole
-/// retry) that are the nearest hole, within `h`, of a cell the verification `v` lists as
-/// failing; in increasing order. What the later rounds of the narrow-hole retry of
-/// [`crate::Mesher::mesh_observed`] leave out.
+/// The holes of `region` whose width (the `hole_width` of the narrow-hole retry: the smaller
+/// side of the bounding box) lies in `widths` and that are the nearest hole, within `h`, of a
+/// cell the verification `v` lists as failing; in increasing order. What the later rounds of
+/// the narrow-hole retry of [`crate::Mesher::mesh_observed`] leave out (widths from one to
+/// `NEAR_HOLE_WIDTH` cell sizes: the narrower ones are gone already).
 pub fn holes_next_to_failures(
     v: &crate::verify::Verification,
     region: &Region,
     h: f64,
-    max_width: f64,
+    widths: std::ops::Range<f64>,
 ) -> Vec<usize> {
     if h.is_nan() || h <= 0.0 || region.holes().is_empty() {
         return Vec::new();
@@ -254,7 +255,7 @@ pub fn holes_next_to_failures(
     count
         .iter()
         .enumerate()
-        .filter(|&(k, &c)| c > 0 && hole_width(&region.holes()[k]).0 < max_width)
+        .filter(|&(k, &c)| c > 0 && widths.contains(&hole_width(&region.holes()[k]).0))
         .map(|(k, _)| k)
         .collect()
 }

@@ -215,12 +215,9 @@ impl Mesher {
                     }
                     // the failing cells of the kept attempt, against the input's holes
                     let near: Vec<usize> =
-                        preflight::holes_next_to_failures(&rv, region, h, NEAR_HOLE_WIDTH * h)
+                        preflight::holes_next_to_failures(&rv, region, h, h..NEAR_HOLE_WIDTH * h)
                             .into_iter()
-                            .filter(|k| {
-                                self.dropped_near_failure.binary_search(k).is_err()
-                                    && unamalla_contour::hole_width(&region.holes()[*k]) >= h
-                            })
+                            .filter(|k| self.dropped_near_failure.binary_search(k).is_err())
                             .collect();
                     if near.is_empty() {
                         break;

@@ -102,10 +102,11 @@ fn failing_cells_beside_a_hole_narrower_than_a_cell_name_the_hole() {
     assert!(small_hole(&far, &r, 0.63).is_none());
 }
 
-/// The later rounds of the narrow-hole retry: the holes narrower than `max_width` that
-/// are the nearest hole, within h, of a failing cell. Hole widths 0.4 (A), 0.3 (B), 2.0
-/// (C); two failing cells beside A, one 0.2 from C. At h = 0.63 (max width 1.26) only A;
-/// at h = 1.1 (max width 2.2) A and C; B has no failing cell; none for cells far away.
+/// The later rounds of the narrow-hole retry: the holes whose width lies in the given range
+/// that are the nearest hole, within h, of a failing cell. Hole widths 0.4 (A), 0.3 (B), 2.0
+/// (C); two failing cells beside A, one 0.2 from C. At h = 0.63, widths below 1.26: only A;
+/// at h = 1.1, widths below 2.2: A and C; widths from h = 1.1 to 2.2: C only (A is narrower
+/// than a cell); B has no failing cell; none for cells far away.
 #[test]
 fn holes_next_to_failures_are_the_narrow_nearest_ones() {
     let r = three_holes();
@@ -115,19 +116,25 @@ fn holes_next_to_failures_are_the_narrow_nearest_ones() {
         non_convex_at: vec![cell(5.5, 5.0), cell(5.0, 4.6), cell(8.2, 2.0)],
         ..Default::default()
     };
-    assert_eq!(holes_next_to_failures(&v, &r, 0.63, 2.0 * 0.63), vec![0]);
-    assert_eq!(holes_next_to_failures(&v, &r, 1.1, 2.0 * 1.1), vec![0, 2]);
+    assert_eq!(holes_next_to_failures(&v, &r, 0.63, 0.0..1.26), vec![0]);
+    assert_eq!(holes_next_to_failures(&v, &r, 1.1, 0.0..2.2), vec![0, 2]);
+    assert_eq!(holes_next_to_failures(&v, &r, 1.1, 1.1..2.2), vec![2]);
+    // the upper end is excluded: C (2.0 wide) is not narrower than 2.0
+    assert_eq!(
+        holes_next_to_failures(&v, &r, 1.1, 1.1..2.0),
+        Vec::<usize>::new()
+    );
     // a cell outside counts by its centroid, as a non-convex one by its corners
     let outside = crate::verify::Verification {
         outside_examples: vec![(7, [8.1, 2.0])],
         ..Default::default()
     };
-    assert_eq!(holes_next_to_failures(&outside, &r, 1.1, 2.2), vec![2]);
+    assert_eq!(holes_next_to_failures(&outside, &r, 1.1, 0.0..2.2), vec![2]);
     let far = crate::verify::Verification {
         non_convex_at: vec![cell(9.5, 9.5)],
         ..Default::default()
     };
-    assert!(holes_next_to_failures(&far, &r, 1.1, 2.2).is_empty());
+    assert!(holes_next_to_failures(&far, &r, 1.1, 0.0..2.2).is_empty());
 }
 
 #[test]
