@@ -173,6 +173,16 @@ pub struct MeshArgs {
     /// naming the hole.
     #[arg(long)]
     pub keep_narrow_holes: bool,
+    /// Leave every hole narrower than this many cell sizes out of the block layout and carve
+    /// it into the smoothed mesh (its cells removed, the nodes around it moved onto its
+    /// contour; report.json "holes_carved"). By default (0) holes are carved only when
+    /// bridging them with cuts fails or stays below --quality-target. For seas with many
+    /// islands a few cells across.
+    #[arg(long, default_value_t = 0.0, value_parser = crate::reliability::finite_number)]
+    pub carve_islands: f64,
+    /// Never carve: the holes the retries leave out of the layout stay out of the mesh.
+    #[arg(long, conflicts_with = "carve_islands")]
+    pub no_carve: bool,
     /// When the automatically chosen layout gives μ ≥ 0.8 on fewer than this share of the
     /// cells (percent), re-make the mesh from the next candidate layouts (at most two more
     /// runs) and keep the best; 0 turns the retry off. Each try is named in report.json's
@@ -369,7 +379,9 @@ fn mesh_part(
     }
     mesher = mesher
         .quality_target(a.quality_target)
-        .drop_narrow_holes(!a.keep_narrow_holes);
+        .drop_narrow_holes(!a.keep_narrow_holes)
+        .carve_dropped_holes(!a.no_carve)
+        .carve_islands(a.carve_islands);
     let mut sopts = SimplifyOptions::default();
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);
@@ -402,7 +414,7 @@ fn mesh_part(
     // dropping holes changes the domain: said on stderr even with --quiet
     if !result.report.holes_dropped.is_empty() && a.min_hole_area.is_none() {
         eprintln!(
-            "warning: {name}: {} hole(s) narrower than the cell size (or than two, next to which the mesh failed) were dropped (report.json \"holes_dropped\", the notes say why); --keep-narrow-holes fails instead, a smaller --cell-size keeps them",
+            "warning: {name}: {} hole(s) at the cell scale were dropped (report.json \"holes_dropped\", the notes say why); --keep-narrow-holes fails instead, a smaller --cell-size keeps them",
             result.report.holes_dropped.len()
         );
     }

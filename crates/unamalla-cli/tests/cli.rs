@@ -178,6 +178,7 @@ fn mesh_writes_every_output_and_report_fields() {
         "area_change_percent",
         "hausdorff",
         "holes_dropped",
+        "holes_carved",
         "seconds",
         "stage_seconds",
     ] {

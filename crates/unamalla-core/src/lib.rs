@@ -22,7 +22,8 @@
 //! program), transfinite interpolation per block, merging into one conformal mesh, and
 //! smoothing with the convexity-preserving functional
 //! `F = (1−σ)·F_AO + σ·H_ω` (area–orthogonality and the adaptive harmonic functional),
-//! then an independent check ([`verify`]) — a mesh with a non-convex cell is never returned
+//! islands at the cell scale carved into the smoothed mesh instead of bridged by cuts
+//! ([`carve`]), then an independent check ([`verify`]) — a mesh with a non-convex cell is never returned
 //! as a success. [`MeshResult::write_all`] writes the file set of `unamalla mesh`
 //! ([`write`](mod@write)); [`MeshReport`] is its `report.json`.
 //!
@@ -62,6 +63,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod bspline_maps;
+pub mod carve;
 pub mod corners;
 pub mod curves;
 mod error;

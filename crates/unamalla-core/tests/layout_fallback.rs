@@ -174,6 +174,7 @@ fn a_failure_next_to_holes_narrower_than_a_cell_is_meshed_without_them() {
     );
     let r = Mesher::new()
         .cells(1_000)
+        .carve_dropped_holes(false)
         .mesh(&reg)
         .expect("meshed without the narrow holes");
     let mut dropped = r.report.holes_dropped.clone();
@@ -200,7 +201,8 @@ fn a_failure_next_to_holes_narrower_than_a_cell_is_meshed_without_them() {
 /// cell folded next to an island between one and two cells across; the later round leaves out
 /// the islands narrower than `NEAR_HOLE_WIDTH` cells next to the failure (not all of them):
 /// the mesh is made, passes the independent check, and every dropped hole is either narrower
-/// than a cell or narrower than two and named in a note.
+/// than a cell or narrower than two and named in a note. (With carving off: by default the
+/// islands are carved, `a_sea_of_islands_is_meshed_with_its_islands_carved`.)
 #[test]
 #[ignore = "meshes a 500-island sea about nine times (≈ 90 s in release): \
             cargo test --release -p unamalla-core --test layout_fallback -- --ignored"]
@@ -217,6 +219,7 @@ fn a_sea_of_islands_one_or_two_cells_across_is_meshed() {
         .count();
     let r = Mesher::new()
         .cells(20_000)
+        .carve_dropped_holes(false)
         .mesh(&reg)
         .expect("the sea is meshed");
     let v = verify_quads(
@@ -241,6 +244,56 @@ fn a_sea_of_islands_one_or_two_cells_across_is_meshed() {
             .notes
             .iter()
             .any(|n| n.contains("narrower than 2 cell sizes")),
+        "{:?}",
+        r.report.notes
+    );
+}
+
+/// The same sea of 500 islands at 20,000 cells with the default carving: after the mesh keeping
+/// every island fails, the islands narrower than `NEAR_HOLE_WIDTH` cells (all 500) leave the
+/// layout and are carved into the mesh of the open sea. Every island at least a quarter of a
+/// cell in area (`carve::MIN_AREA_FRACTION`) is carved unless its cells touch another carved
+/// island; the mesh passes the independent check with μ ≥ 0.8 on at least 90 % of the cells.
+#[test]
+#[ignore = "meshes a 500-island sea about five times (≈ 30 s in release): \
+            cargo test --release -p unamalla-core --test layout_fallback -- --ignored"]
+fn a_sea_of_islands_is_meshed_with_its_islands_carved() {
+    use unamalla_core::carve::MIN_AREA_FRACTION;
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/synthetic/archipelago-500.geojson");
+    let reg = io::read_region_geojson(p, PartSelector::Largest).unwrap();
+    let r = Mesher::new()
+        .cells(20_000)
+        .mesh(&reg)
+        .expect("the sea is meshed");
+    let v = verify_quads(
+        r.mesh.global(),
+        Some(&r.simplified),
+        &VerifyOptions::default(),
+    );
+    assert!(v.passed(), "{v}");
+    assert_eq!(r.report.interior_singularities, 0);
+    let (carved, dropped) = (&r.report.holes_carved, &r.report.holes_dropped);
+    assert_eq!(carved.len() + dropped.len(), 500);
+    assert_eq!(r.simplified.holes().len(), carved.len());
+    // the cell area of the request, with a margin for the cells' spread of sizes
+    let cell = reg.area() / 20_000.0;
+    let big = (0..500)
+        .filter(|&k| reg.holes()[k].area() >= 2.0 * MIN_AREA_FRACTION * cell)
+        .collect::<Vec<_>>();
+    let missed = big.iter().filter(|k| !carved.contains(k)).count();
+    assert!(
+        missed * 50 <= big.len(),
+        "{missed} of {} large islands not carved",
+        big.len()
+    );
+    assert!(
+        r.report.mu_ge_0_8_percent >= 90.0,
+        "{}",
+        r.report.mu_ge_0_8_percent
+    );
+    assert!(
+        r.report.notes.iter().any(|n| n.starts_with("carved ")),
         "{:?}",
         r.report.notes
     );

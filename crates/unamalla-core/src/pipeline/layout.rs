@@ -31,6 +31,16 @@ pub const NEAR_HOLE_ROUNDS: usize = 2;
 /// cells, docs/results.md).
 pub const NEAR_HOLE_WIDTH: f64 = 2.0;
 
+/// The widest hole, in cell sizes, the pipeline carves out of the mesh ([`crate::carve`])
+/// instead of bridging it with cuts. The narrow-hole retry and the carving retry of
+/// [`Mesher::mesh_observed`] first leave the holes narrower than [`NEAR_HOLE_WIDTH`] cell sizes
+/// out of the layout; when the block decomposition still finds no admissible cuts around the
+/// rest (a sea of islands two to three cells across), the width doubles up to this one. A
+/// carved hole is a rectangle of cells whose ring of nodes moves onto the island's contour; up
+/// to four cells across its corner cells still keep convex angles near 135° around a round
+/// island, while larger islands get blocks of their own.
+pub const CARVE_MAX_WIDTH: f64 = 4.0;
+
 /// Margin (share of cells) by which the chord layout's prediction must beat the concavity
 /// layout's to be chosen: the prediction is made on a coarse mesh with a few Laplacian sweeps,
 /// so differences below a percent are not resolved by it (`tests/predictor.rs`).

@@ -38,6 +38,16 @@
 //!    is not the TFI mesh but one prolonged from the same decomposition meshed and smoothed with a
 //!    quarter of the cells ([`crate::multilevel`], nested iteration; [`Mesher::coarse_levels`]);
 //!    the TFI start is kept when that one is not convex.
+//!
+//!    7b′. **carve** the islands left out of the layout back in ([`crate::carve`]): when
+//!    bridging holes at the cell scale fails the guarantee or stays below the quality target
+//!    ([`Mesher::mesh_observed`]), or when asked ([`Mesher::carve_islands`]), the holes narrower
+//!    than [`NEAR_HOLE_WIDTH`] cell sizes (up to [`CARVE_MAX_WIDTH`] when the decomposition finds
+//!    no cuts around the rest) are left out of the layout; each is then removed from the smoothed
+//!    mesh as a logical rectangle of cells (a land mask, as in structured ocean models: Griffies
+//!    et al. 2000, Ocean Modelling 2, §3) whose ring of nodes moves onto the island's contour,
+//!    its block split into the eight blocks around it, and the carved mesh is untangled and
+//!    smoothed again with the island rings fixed;
 //! 8. **report** quality ([`QualityReport`]) and fidelity (area change, Hausdorff distance of
 //!    the mesh boundary to the input region).
 //!
@@ -78,6 +88,7 @@ use unamalla_optim::{
 
 use crate::CoreError;
 
+mod islands;
 mod layout;
 mod report;
 mod run;
@@ -210,6 +221,15 @@ pub struct Mesher {
     /// narrow-hole retry of [`Mesher::mesh_observed`] for the holes near the cell scale next to
     /// which a retry still failed.
     dropped_near_failure: Vec<usize>,
+    /// Whether the holes the narrow-hole retry leaves out are carved back in
+    /// ([`Mesher::carve_dropped_holes`]).
+    carve_dropped: bool,
+    /// Holes narrower than this many cell sizes are carved instead of bridged
+    /// ([`Mesher::carve_islands`]; 0 = only by the retries).
+    carve_width: f64,
+    /// Set by the narrow-hole retry of [`Mesher::mesh_observed`]: the holes dropped by the
+    /// simplification were left out by the pipeline, not by the user's filter.
+    auto_dropped: bool,
     /// Candidate layouts [`choose_layout`] must not pick (set by the fallback of
     /// [`Mesher::mesh_observed`] after a layout failed the guarantee).
     excluded_layouts: Vec<String>,
@@ -293,6 +313,9 @@ impl Mesher {
             quality_target: QUALITY_TARGET_PERCENT,
             drop_narrow_holes: true,
             dropped_near_failure: Vec::new(),
+            carve_dropped: true,
+            carve_width: 0.0,
+            auto_dropped: false,
             excluded_layouts: Vec::new(),
         }
     }
@@ -357,6 +380,31 @@ impl Mesher {
     /// size keeps the holes).
     pub fn drop_narrow_holes(mut self, yes: bool) -> Self {
         self.drop_narrow_holes = yes;
+        self
+    }
+    /// Whether the holes the narrow-hole retry of [`Mesher::drop_narrow_holes`] left out of the
+    /// layout are carved back into the smoothed mesh (default `true`): the cells covering each
+    /// such island are removed, the nodes around them moved onto its contour, and the mesh
+    /// smoothed again ([`crate::carve`]). The islands carved are listed in
+    /// [`MeshReport::holes_carved`], the others stay in [`MeshReport::holes_dropped`] and the
+    /// report's notes say why. Holes dropped by a hole filter the user set are never carved.
+    pub fn carve_dropped_holes(mut self, yes: bool) -> Self {
+        self.carve_dropped = yes;
+        self
+    }
+    /// Leaves every hole narrower than `width` cell sizes out of the block layout from the start
+    /// and carves it into the smoothed mesh ([`crate::carve`]; default 0: only the retries of
+    /// [`Mesher::mesh_observed`] do, when bridging such holes fails or stays below the quality
+    /// target). For seas with many islands a few cells across, this skips the attempts that
+    /// bridge them. Applies with the default hole filter ([`HoleFilter::KeepAll`]) only; the
+    /// islands carved are listed in [`MeshReport::holes_carved`], those too small to carve in
+    /// [`MeshReport::holes_dropped`]. Negative or non-finite values are 0.
+    pub fn carve_islands(mut self, width: f64) -> Self {
+        self.carve_width = if width.is_finite() {
+            width.max(0.0)
+        } else {
+            0.0
+        };
         self
     }
     /// About `n` cells.

@@ -38,6 +38,9 @@ pub struct MeshReport {
     pub hausdorff: f64,
     /// Input holes that were dropped (indices in input order).
     pub holes_dropped: Vec<usize>,
+    /// Input holes left out of the block layout and carved back into the mesh
+    /// ([`Mesher::carve_dropped_holes`]; indices in input order).
+    pub holes_carved: Vec<usize>,
     /// Smoother status message.
     pub smoothing: String,
     /// What the shape pass after the smoothing did (`None` when it is off).

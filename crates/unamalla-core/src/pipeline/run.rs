@@ -22,7 +22,7 @@ impl Mesher {
         }
     }
 
-    fn stage(&mut self, s: Stage, msg: &str) {
+    pub(super) fn stage(&mut self, s: Stage, msg: &str) {
         if let Some(f) = self.progress.as_mut() {
             f(s, msg);
         }
@@ -136,6 +136,16 @@ impl Mesher {
             limit,
         )?;
         let allow = self.allow_non_convex;
+        // islands carved from the start ([`Mesher::carve_islands`])
+        if self.carve_width > 0.0 && h > 0.0 {
+            if let Some(o) = self.simplify.as_mut() {
+                if o.holes == HoleFilter::KeepAll {
+                    o.holes = HoleFilter::MinWidth(self.carve_width * h);
+                    self.auto_dropped = true;
+                    self.carve_dropped = true;
+                }
+            }
+        }
         if self.simplify.is_none() && self.decomposition.is_none() {
             preflight::check_unsimplified(region)?;
             if !allow {
@@ -183,21 +193,59 @@ impl Mesher {
                 .filter(|hole| unamalla_contour::hole_width(hole) < h)
                 .count();
             if default_filter && narrow > 0 && preflight::small_hole(&v, region, h).is_some() {
-                let note = format!(
-                    "the mesh keeping every hole failed the guarantee next to a hole narrower than the cell size {h:.4e}; made again without the {narrow} hole(s) narrower than that (a cell size of at most half their width keeps them)"
-                );
+                // with carving, every hole at the cell scale (narrower than NEAR_HOLE_WIDTH · h)
+                // leaves the layout, which then has no blocks a cell or two thick, and is carved
+                // back into the smoothed mesh; without, only those narrower than a cell go
+                let width = if self.carve_dropped {
+                    NEAR_HOLE_WIDTH * h
+                } else {
+                    h
+                };
+                let dropped = region
+                    .holes()
+                    .iter()
+                    .filter(|hole| unamalla_contour::hole_width(hole) < width)
+                    .count();
+                let note = if self.carve_dropped {
+                    format!(
+                        "the mesh keeping every hole failed the guarantee next to a hole narrower than the cell size {h:.4e}; made again with the {dropped} hole(s) narrower than {NEAR_HOLE_WIDTH} cell sizes left out of the block layout and carved back into the mesh"
+                    )
+                } else {
+                    format!(
+                        "the mesh keeping every hole failed the guarantee next to a hole narrower than the cell size {h:.4e}; made again without the {narrow} hole(s) narrower than that (a cell size of at most half their width keeps them)"
+                    )
+                };
                 self.stage(Stage::Decompose, &note);
                 if let Some(o) = self.simplify.as_mut() {
-                    o.holes = HoleFilter::MinWidth(h);
+                    o.holes = HoleFilter::MinWidth(width);
                 }
+                self.auto_dropped = true;
                 self.excluded_layouts.clear();
                 let mut notes = vec![note];
                 // round 0 without the holes narrower than a cell; each later round (at most
                 // NEAR_HOLE_ROUNDS) also without the holes narrower than NEAR_HOLE_WIDTH · h
                 // next to which the previous round failed
+                let mut width = width;
                 for round in 0..=NEAR_HOLE_ROUNDS {
-                    let Ok(retry) = self.mesh_unverified(region, observer) else {
-                        break;
+                    let retry = match self.mesh_unverified(region, observer) {
+                        Ok(retry) => retry,
+                        // with carving, a decomposition that finds no cuts around the holes
+                        // left is made again with wider holes left out (up to CARVE_MAX_WIDTH)
+                        Err(e) if self.carve_dropped && 2.0 * width <= CARVE_MAX_WIDTH * h => {
+                            width *= 2.0;
+                            let note = format!(
+                                "the layout without them failed ({e}); made again with the holes narrower than {} cell sizes left out and carved back in",
+                                width / h
+                            );
+                            self.stage(Stage::Decompose, &note);
+                            notes.push(note);
+                            if let Some(o) = self.simplify.as_mut() {
+                                o.holes = HoleFilter::MinWidth(width);
+                            }
+                            self.excluded_layouts.clear();
+                            continue;
+                        }
+                        Err(_) => break,
                     };
                     let rv = verify(&retry);
                     // the layout fallback once more, on the region without those holes
@@ -278,6 +326,83 @@ impl Mesher {
                 v = rv;
             }
         }
+        // islands carved instead of bridged: a mesh that passed but stayed below the quality
+        // target, in a region with holes narrower than NEAR_HOLE_WIDTH · h (the layout gives each
+        // blocks a cell or two thick), is made once more with those holes left out of the layout
+        // and carved back into the mesh ([`Mesher::carve_dropped_holes`]), and kept if it passes
+        // with a higher share
+        if !allow
+            && v.passed()
+            && self.quality_target > 0.0
+            && result.report.mu_ge_0_8_percent < self.quality_target
+            && self.carve_dropped
+            && self.drop_narrow_holes
+            && !self.auto_dropped
+            && h > 0.0
+            && self
+                .simplify
+                .as_ref()
+                .is_some_and(|o| o.holes == HoleFilter::KeepAll)
+        {
+            let mut width = NEAR_HOLE_WIDTH * h;
+            while width <= CARVE_MAX_WIDTH * h {
+                let small = region
+                    .holes()
+                    .iter()
+                    .filter(|hole| unamalla_contour::hole_width(hole) < width)
+                    .count();
+                if small == 0 {
+                    break;
+                }
+                let note = format!(
+                    "μ ≥ 0.8 on {:.1} % of the cells, below the target {} %; made again with the {small} hole(s) narrower than {} cell sizes left out of the block layout and carved back into the mesh",
+                    result.report.mu_ge_0_8_percent,
+                    self.quality_target,
+                    width / h
+                );
+                self.stage(Stage::Decompose, &note);
+                failed.push(note);
+                if let Some(o) = self.simplify.as_mut() {
+                    o.holes = HoleFilter::MinWidth(width);
+                }
+                self.auto_dropped = true;
+                self.excluded_layouts.clear();
+                match self.mesh_unverified(region, observer) {
+                    Ok(retry) => {
+                        let rv = verify(&retry);
+                        let ((retry, rv), _) = self.layout_fallback(
+                            region,
+                            observer,
+                            &verify,
+                            (retry, rv),
+                            &mut failed,
+                        );
+                        let share = retry.report.mu_ge_0_8_percent;
+                        let kept = rv.passed() && share > result.report.mu_ge_0_8_percent;
+                        failed.push(format!(
+                            "with the islands carved: μ ≥ 0.8 on {share:.1} % ({})",
+                            if kept {
+                                "kept"
+                            } else if !rv.passed() {
+                                "failed the guarantee: not kept"
+                            } else {
+                                "not better: not kept"
+                            }
+                        ));
+                        if kept {
+                            result = retry;
+                            v = rv;
+                        }
+                        break;
+                    }
+                    // the decomposition found no cuts around the holes left: carve wider ones
+                    Err(e) => {
+                        failed.push(format!("the layout without them failed ({e})"));
+                        width *= 2.0;
+                    }
+                }
+            }
+        }
         if !failed.is_empty() {
             result.report.seconds = t_start.elapsed().as_secs_f64();
             let mut notes = failed;
@@ -355,6 +480,59 @@ impl Mesher {
         Some((retry, rv))
     }
 
+    /// Pipeline steps 7a (local untangling patches) and 7b (the global smoothing run, ended by
+    /// the convergence tests of `sopts.solver.stop`) on `mesh`; returns the smoother's status.
+    pub(super) fn untangle_and_smooth(
+        &mut self,
+        mesh: &mut BlockMesh2,
+        sopts: &SmoothOptions,
+        t_stage: Instant,
+        observer: &mut dyn Observer,
+    ) -> Result<String, CoreError> {
+        let mut sopts = sopts.clone();
+        // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
+        // block boundaries ([`crate::untangle`]): small problems converge in far fewer
+        // iterations than the global one, the work is bounded by iteration limits (not
+        // wall-clock time, so the result does not depend on the load), and the global run
+        // below then starts convex (or nearly so)
+        let patches = crate::untangle::untangle_patches_observed(
+            mesh.global_mut(),
+            &sopts,
+            &crate::untangle::DEFAULT_PATCH_RADII,
+            observer,
+        )?;
+        if patches.before > 0 {
+            mesh.sync_blocks();
+            let msg = format!(
+                "untangled {} → {} non-convex cells in {} local patch(es) (radius ≤ {}, {} iterations, {:.2} s)",
+                patches.before,
+                patches.after,
+                patches.patches,
+                patches.max_radius,
+                patches.iterations,
+                t_stage.elapsed().as_secs_f64()
+            );
+            self.stage(Stage::Smooth, &msg);
+            if !patches.unresolved.is_empty() {
+                let msg = format!(
+                    "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
+                    patches.unresolved.len(),
+                    if patches.cancelled { " (cancelled)" } else { "" },
+                    &patches.unresolved[..patches.unresolved.len().min(8)],
+                    if patches.unresolved.len() > 8 { ", …" } else { "" },
+                );
+                self.stage(Stage::Smooth, &msg);
+            }
+        }
+        // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
+        if let Some(t) = self.time_limit {
+            sopts.time_limit = Some((t - t_stage.elapsed().as_secs_f64()).max(0.0));
+        }
+        let smoothing = smooth(mesh, &sopts, observer)?;
+        mesh.sync_blocks();
+        Ok(smoothing.status.to_string())
+    }
+
     /// The pipeline without the checks of [`Mesher::mesh_observed`].
     fn mesh_unverified(
         &mut self,
@@ -372,12 +550,15 @@ impl Mesher {
         // 1. simplify, 1b. remove the features below the cell size
         self.stage(Stage::Simplify, "simplifying the contour");
         let prepared = self.prepare_region(region)?;
-        let holes_dropped = prepared.holes_dropped;
+        let mut holes_dropped = prepared.holes_dropped;
+        // the dropped holes carved back in (step 7b′) and the note saying so
+        let mut holes_carved: Vec<usize> = Vec::new();
+        let mut carve_notes: Vec<String> = Vec::new();
         let neck_notes: Vec<String> = prepared.necks.iter().map(|c| c.to_string()).collect();
         // a decomposition file fits either region: ours (saved by a previous run) fits the one
         // without features, one made by hand for the simplified region fits the other
         // (validated here, once: the error names the simplified region when neither fits)
-        let simplified = match &self.decomposition {
+        let mut simplified = match &self.decomposition {
             Some(d) if d.validate(&prepared.mesh_region).is_err() => {
                 d.validate(&prepared.simplified)?;
                 prepared.simplified
@@ -528,48 +709,28 @@ impl Mesher {
                     sopts = crate::multilevel::polish_options(&sopts);
                 }
             }
-            // 7a. the folded cells (TFI of a wiggly block) are untangled in local patches across
-            // block boundaries ([`crate::untangle`]): small problems converge in far fewer
-            // iterations than the global one, the work is bounded by iteration limits (not
-            // wall-clock time, so the result does not depend on the load), and the global run
-            // below then starts convex (or nearly so)
-            let patches = crate::untangle::untangle_patches_observed(
-                mesh.global_mut(),
-                &sopts,
-                &crate::untangle::DEFAULT_PATCH_RADII,
-                observer,
-            )?;
-            if patches.before > 0 {
-                mesh.sync_blocks();
-                let msg = format!(
-                    "untangled {} → {} non-convex cells in {} local patch(es) (radius ≤ {}, {} iterations, {:.2} s)",
-                    patches.before,
-                    patches.after,
-                    patches.patches,
-                    patches.max_radius,
-                    patches.iterations,
-                    t_stage.elapsed().as_secs_f64()
-                );
-                self.stage(Stage::Smooth, &msg);
-                if !patches.unresolved.is_empty() {
-                    let msg = format!(
-                        "{} fold(s) could not be removed by local patches{} (cells {:?}{}); left to the global run",
-                        patches.unresolved.len(),
-                        if patches.cancelled { " (cancelled)" } else { "" },
-                        &patches.unresolved[..patches.unresolved.len().min(8)],
-                        if patches.unresolved.len() > 8 { ", …" } else { "" },
-                    );
-                    self.stage(Stage::Smooth, &msg);
+            let status = self.untangle_and_smooth(&mut mesh, &sopts, t_stage, observer)?;
+            // 7b′. islands the narrow-hole retry left out of the layout, carved back in
+            // ([`crate::carve`]) and the carved mesh smoothed again
+            if self.carve_dropped && self.auto_dropped && !holes_dropped.is_empty() {
+                self.stage(Stage::Smooth, "carving the islands left out of the layout");
+                let islands = super::islands::Islands {
+                    input: region,
+                    simplified: &simplified,
+                    dropped: &holes_dropped,
+                };
+                let (step, note) = self.carve_dropped(&mesh, islands, &sopts, t_stage, observer)?;
+                self.stage(Stage::Smooth, &note);
+                carve_notes.push(note);
+                if let Some(c) = step {
+                    mesh = c.mesh;
+                    simplified = c.region;
+                    holes_dropped.retain(|k| c.carved.binary_search(k).is_err());
+                    holes_carved = c.carved;
                 }
             }
-            // 7b. the global run, ended by the convergence tests of `sopts.solver.stop`
-            if let Some(t) = self.time_limit {
-                sopts.time_limit = Some((t - t_stage.elapsed().as_secs_f64()).max(0.0));
-            }
-            let smoothing = smooth(&mut mesh, &sopts, observer)?;
-            mesh.sync_blocks();
             lap(Stage::Smooth, &mut timer);
-            smoothing.status.to_string()
+            status
         };
 
         // 7c. local shape improvement, the region-boundary nodes sliding along the boundary
@@ -628,6 +789,7 @@ impl Mesher {
             area_change_percent,
             hausdorff,
             holes_dropped,
+            holes_carved,
             smoothing: smoothing_status,
             shape,
             seconds: t0.elapsed().as_secs_f64(),
@@ -653,7 +815,11 @@ impl Mesher {
                 .unwrap_or_default(),
             layout: layout_choice,
             quality,
-            notes: neck_notes.into_iter().chain(counts_notes).collect(),
+            notes: neck_notes
+                .into_iter()
+                .chain(counts_notes)
+                .chain(carve_notes)
+                .collect(),
             verification: Default::default(),
         };
         Ok(MeshResult {
