@@ -136,14 +136,20 @@ fn rule_breaks(
 /// with the singularities, before the prediction; measured on the 34 development regions:
 /// docs/results.md, "Seventh pass".)
 ///
-/// A chosen chord layout is then **re-split by the prediction**: the block with the most
+/// The chosen layout is then **re-split by the prediction**: the block with the most
 /// predicted bad cells (`(1 − share)·cells`, share below [`RESPLIT_BELOW`]) that has a chord
 /// of score ≥ [`RESPLIT_SCORE`] between boundary points or layout cuts
 /// ([`unamalla_decompose::split_chord`]) gets it as one more layout cut; the layout is rebuilt
 /// ([`unamalla_decompose::layout_from_cuts`]) and predicted again, and the cut is kept when the
 /// predicted share rises by at least [`RESPLIT_GAIN`] without more rule breaks. At most
 /// [`RESPLIT_EVALS`] candidates are tried, on layouts of at most [`RESPLIT_MAX_BLOCKS`]
-/// blocks, so the work is bounded.
+/// blocks, so the work is bounded. For a chord layout the layout cuts are its chords; for the
+/// concavity layout they are its own cuts in the order Algorithm 1 made them. (Until the fifth
+/// session of 2026-12-06 only chord layouts were re-split: the concavity layout of the crow
+/// kept its body — back and belly converging towards the tail — in one block predicted at
+/// 67 %, whose smoothed cells showed diagonal bands of shear; one transverse cut raised the
+/// mesh from 94.7 to 98.9 % at 20,000 cells. Measured on the 34 regions: docs/results.md,
+/// "The concavity layout re-split too".)
 pub fn choose_layout(
     region: &Region,
     opts: &DecomposeOptions,
@@ -258,6 +264,12 @@ pub fn choose_layout_excluding(
                     let o = opts.clone().chord_aspect(aspect);
                     resplit(region, &o, size, cuts, d, p)
                 }
+                // the concavity layout: its own cuts, in the order they were made, are the
+                // layout cuts the split chords are added to
+                (None, None) => {
+                    let cuts: Vec<(DVec2, DVec2)> = d.cuts.iter().map(|c| (c.a, c.b)).collect();
+                    resplit(region, &conc_opts, size, cuts, d, p)
+                }
                 _ => (d, p, 0, 0),
             };
             let choice = LayoutChoice {
@@ -290,7 +302,7 @@ pub fn choose_layout_excluding(
 /// The split chords found by [`resplit`], by (block geometry key, number of layout cuts).
 type ChordCache = std::collections::HashMap<(Vec<u64>, usize), Option<(DVec2, DVec2)>>;
 
-/// The predicted-quality re-split of a chord layout ([`choose_layout`]): returns the
+/// The predicted-quality re-split of a layout ([`choose_layout`]): returns the
 /// decomposition, its prediction, the cuts added and the candidates tried.
 fn resplit(
     region: &Region,
