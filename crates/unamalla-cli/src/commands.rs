@@ -135,7 +135,8 @@ pub struct MeshArgs {
     /// Boundary density w of (6.9) (1 = plain (6.8)).
     #[arg(long, default_value_t = 1.0)]
     pub boundary_density: f64,
-    /// Drop holes smaller than this area (region units squared); by default every hole is kept.
+    /// Drop holes smaller than this area (region units squared) up front (by default no hole is
+    /// dropped by area; islands narrower than a cell are carved, see --carve-islands).
     #[arg(long)]
     pub min_hole_area: Option<f64>,
     /// Mesh the region as given, without contour simplification.
@@ -167,20 +168,23 @@ pub struct MeshArgs {
     /// (the shape pass moves interior nodes only).
     #[arg(long)]
     pub no_slide: bool,
-    /// Never drop holes: by default, when the mesh fails next to a hole narrower than the
-    /// cell size, it is made again without the holes narrower than a cell (listed in
-    /// report.json's "holes_dropped", with a warning); with this flag the run fails instead,
-    /// naming the hole.
+    /// Never drop holes: every hole stays in the block layout (none is carved), and where the
+    /// mesh fails next to a hole narrower than the cell size the run fails, naming the hole. By
+    /// default islands narrower than a cell are carved and those too small to carve dropped,
+    /// and a failure next to such a hole is meshed again without it (report.json
+    /// "holes_dropped", with a warning).
     #[arg(long)]
     pub keep_narrow_holes: bool,
     /// Leave every hole narrower than this many cell sizes out of the block layout and carve
     /// it into the smoothed mesh (its cells removed, the nodes around it moved onto its
-    /// contour; report.json "holes_carved"). By default (0) holes are carved only when
-    /// bridging them with cuts fails or stays below --quality-target. For seas with many
-    /// islands a few cells across.
-    #[arg(long, default_value_t = 0.0, value_parser = crate::reliability::finite_number)]
-    pub carve_islands: f64,
-    /// Never carve: the holes the retries leave out of the layout stay out of the mesh.
+    /// contour; report.json "holes_carved"); islands too small to carve are dropped
+    /// ("holes_dropped"). Default 1 (islands narrower than a cell); wider ones are carved too
+    /// when bridging them with cuts fails or stays below --quality-target. Larger values suit
+    /// seas with many islands a few cells across.
+    #[arg(long, value_parser = crate::reliability::finite_number)]
+    pub carve_islands: Option<f64>,
+    /// Never carve: every hole stays in the block layout, and the holes the retries leave out
+    /// stay out of the mesh.
     #[arg(long, conflicts_with = "carve_islands")]
     pub no_carve: bool,
     /// When the automatically chosen layout gives μ ≥ 0.8 on fewer than this share of the
@@ -380,8 +384,10 @@ fn mesh_part(
     mesher = mesher
         .quality_target(a.quality_target)
         .drop_narrow_holes(!a.keep_narrow_holes)
-        .carve_dropped_holes(!a.no_carve)
-        .carve_islands(a.carve_islands);
+        .carve_dropped_holes(!a.no_carve);
+    if let Some(w) = a.carve_islands {
+        mesher = mesher.carve_islands(w);
+    }
     let mut sopts = SimplifyOptions::default();
     if let Some(area) = a.min_hole_area {
         sopts.holes = HoleFilter::MinArea(area);

@@ -208,8 +208,8 @@ fn small_holes_are_dropped_and_reported() {
     assert!((res.relative_area_change - 1.0 / 9599.0).abs() < 1e-15);
 }
 
-/// `HoleFilter::MinWidth`: a hole is dropped when the smaller side of its bounding box is
-/// below the width — here a 30 × 0.5 slit (width 0.5, area 15) goes at width 1 although it is
+/// `HoleFilter::MinWidth`: a hole is dropped when its width (minimum width of its convex hull)
+/// is below the width — here a 30 × 0.5 slit (width 0.5, area 15) goes at width 1 although it is
 /// larger than the 1 × 1 square (width 1, kept: not below 1) and the 20 × 20 square.
 #[test]
 fn narrow_holes_are_dropped_by_width_not_area() {
@@ -229,6 +229,37 @@ fn narrow_holes_are_dropped_by_width_not_area() {
     assert_eq!(res.region.holes().len(), 2);
     o.holes = HoleFilter::MinWidth(f64::NAN);
     assert!(simplify_region(&region, &o).is_err());
+}
+
+/// `hole_width` does not depend on the orientation: a 10 × 0.5 rectangle turned by 45° has a
+/// bounding box of side (10 + 0.5)/√2 ≈ 7.42 but width 0.5; a regular octagon of circumradius
+/// r has width 2r·cos(22.5°) (between two opposite sides) whatever its turn; a triangle has
+/// width 2·area / (longest side) (its smallest height).
+#[test]
+fn hole_width_is_the_minimum_width_of_the_hull() {
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let turn = |p: DVec2| v(s * (p.x - p.y), s * (p.x + p.y));
+    let rect: Vec<DVec2> = [v(0., 0.), v(10., 0.), v(10., 0.5), v(0., 0.5)]
+        .into_iter()
+        .map(turn)
+        .collect();
+    let w = unamalla_contour::hole_width(&unamalla_mesh::Polygon::new(rect).unwrap());
+    assert!((w - 0.5).abs() < 1e-12, "{w}");
+    for t0 in [0.0, 0.1, 0.3927] {
+        let oct: Vec<DVec2> = (0..8)
+            .map(|k| {
+                let t = t0 + std::f64::consts::FRAC_PI_4 * k as f64;
+                v(2.0 * t.cos(), 2.0 * t.sin())
+            })
+            .collect();
+        let w = unamalla_contour::hole_width(&unamalla_mesh::Polygon::new(oct).unwrap());
+        let expected = 4.0 * (std::f64::consts::PI / 8.0).cos();
+        assert!((w - expected).abs() < 1e-12, "{w} against {expected}");
+    }
+    // triangle (0,0), (10,0), (2,3): area 15, longest side 10 → width 3
+    let tri = vec![v(0., 0.), v(10., 0.), v(2., 3.)];
+    let w = unamalla_contour::hole_width(&unamalla_mesh::Polygon::new(tri).unwrap());
+    assert!((w - 3.0).abs() < 1e-12, "{w}");
 }
 
 #[test]

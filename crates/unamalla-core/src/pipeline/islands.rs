@@ -24,7 +24,8 @@ pub(super) struct Islands<'a> {
 }
 
 /// Carving attempts of [`Mesher::carve_dropped`]: after the first, the islands next to the
-/// cells the re-smoothing left non-convex are left out and the rest carved again once.
+/// cells the re-smoothing left non-convex are left out and the rest carved again once (one
+/// more attempt is allowed after leaving out the islands whose ring crossed the boundary).
 const CARVE_ATTEMPTS: usize = 2;
 
 impl Mesher {
@@ -48,7 +49,9 @@ impl Mesher {
             dropped,
         } = islands;
         let mut left_out: Vec<usize> = Vec::new();
-        for attempt in 0..CARVE_ATTEMPTS {
+        // islands left out because their ring crossed the meshed region's boundary
+        let mut invalid = 0;
+        for attempt in 0..CARVE_ATTEMPTS + 1 {
             let islands: Vec<(usize, &Polygon)> = dropped
                 .iter()
                 .filter(|k| !left_out.contains(k))
@@ -56,7 +59,7 @@ impl Mesher {
                 .collect();
             let c = carve_islands(mesh, &islands)?;
             let carved = c.carved_ids();
-            let skipped = skip_summary(&c.outcomes, left_out.len());
+            let skipped = skip_summary(&c.outcomes, left_out.len() - invalid, invalid);
             if carved.is_empty() {
                 let note = format!(
                     "none of the {} island(s) left out of the layout carved back into the mesh{skipped}",
@@ -64,18 +67,16 @@ impl Mesher {
                 );
                 return Ok((None, note));
             }
-            let mut holes: Vec<Vec<DVec2>> = simplified
-                .holes()
-                .iter()
-                .map(|h| h.points().to_vec())
-                .collect();
-            holes.extend(c.rings());
-            let Ok(region) = Region::new(simplified.outer().points().to_vec(), holes) else {
-                let note = format!(
-                    "the {} island(s) left out of the layout not carved back: their carved rings do not make a valid region with the meshed one",
-                    dropped.len()
-                );
-                return Ok((None, note));
+            // the meshed region with the carved rings as holes; a ring that does not make a valid
+            // region with it (an islet the simplified coast passes through) is left out and the
+            // rest carved again
+            let region = match with_rings(simplified, &c) {
+                Ok(region) => region,
+                Err(bad) => {
+                    invalid += bad.len();
+                    left_out.extend(bad);
+                    continue;
+                }
             };
             let removed: usize = c
                 .outcomes
@@ -104,7 +105,7 @@ impl Mesher {
                 };
                 return Ok((Some(step), note));
             }
-            if attempt + 1 == CARVE_ATTEMPTS {
+            if attempt >= CARVE_ATTEMPTS {
                 break;
             }
             // the islands within a cell of the cells left non-convex
@@ -144,8 +145,38 @@ impl Mesher {
     }
 }
 
+/// The meshed region `simplified` with the rings carved in `c` as holes, or the ids of the
+/// islands whose ring does not make a valid region with it (each ring added alone to the rings
+/// that did).
+fn with_rings(simplified: &Region, c: &crate::carve::Carved) -> Result<Region, Vec<usize>> {
+    let outer = simplified.outer().points().to_vec();
+    let mut holes: Vec<Vec<DVec2>> = simplified
+        .holes()
+        .iter()
+        .map(|h| h.points().to_vec())
+        .collect();
+    let rings = c.rings();
+    let all: Vec<Vec<DVec2>> = holes.iter().cloned().chain(rings.iter().cloned()).collect();
+    if let Ok(region) = Region::new(outer.clone(), all) {
+        return Ok(region);
+    }
+    let mut bad = Vec::new();
+    for (id, ring) in c.carved_ids().into_iter().zip(rings) {
+        holes.push(ring);
+        if Region::new(outer.clone(), holes.clone()).is_err() {
+            holes.pop();
+            bad.push(id);
+        }
+    }
+    if bad.is_empty() {
+        // the rings are valid one by one but not all together: leave them all out
+        bad = c.carved_ids();
+    }
+    Err(bad)
+}
+
 /// `; N not carved (a: reason, …)` for the islands skipped, or empty.
-fn skip_summary(outcomes: &[(usize, CarveOutcome)], left_out: usize) -> String {
+fn skip_summary(outcomes: &[(usize, CarveOutcome)], left_out: usize, invalid: usize) -> String {
     let reasons = [
         CarveSkip::BelowHalfCell,
         CarveSkip::OutsideMesh,
@@ -166,6 +197,11 @@ fn skip_summary(outcomes: &[(usize, CarveOutcome)], left_out: usize) -> String {
     if left_out > 0 {
         parts.push(format!(
             "{left_out}: the smoothing left a cell next to it non-convex"
+        ));
+    }
+    if invalid > 0 {
+        parts.push(format!(
+            "{invalid}: its ring crosses the meshed region's boundary"
         ));
     }
     if parts.is_empty() {

@@ -150,6 +150,14 @@ pub const DEFAULT_FEATURE_FACTOR: f64 = 5.0;
 /// docs/results.md).
 pub const DEFAULT_NECK_FACTOR: f64 = 1.0;
 
+/// Default of [`Mesher::carve_islands`]: holes narrower than one cell size leave the block
+/// layout and are carved into the smoothed mesh ([`crate::carve`]) — a feature smaller than
+/// the cell scale must not make blocks that force finer cells elsewhere; bridged by cuts, an
+/// islet of 0.4 cells next to the Gulf of Mexico's coast made a sliver block one cell thick
+/// whose cells had μ ≈ 0.02 and held the smoother at its convexity floor for hundreds of
+/// iterations (docs/results.md, "Islands narrower than a cell carved by default").
+pub const DEFAULT_CARVE_WIDTH: f64 = 1.0;
+
 /// Largest accepted relative area change of the mesh against the **input** region (20 %),
 /// checked when no hole was dropped on purpose: the default simplification keeps the change
 /// below 2 % on the bundled regions (docs/results.md), and the feature removal may drop a
@@ -314,7 +322,7 @@ impl Mesher {
             drop_narrow_holes: true,
             dropped_near_failure: Vec::new(),
             carve_dropped: true,
-            carve_width: 0.0,
+            carve_width: DEFAULT_CARVE_WIDTH,
             auto_dropped: false,
             excluded_layouts: Vec::new(),
         }
@@ -376,14 +384,18 @@ impl Mesher {
     /// that mesh fails too, at most [`NEAR_HOLE_ROUNDS`] more runs each also leave out the
     /// holes narrower than `NEAR_HOLE_WIDTH · h` that lie within `h` of a failing cell (an
     /// island one or two cells across gets blocks too thin to untangle, as one narrower than a
-    /// cell does; the others stay). With `false` the run fails with the error naming the hole and the remedies (a smaller cell
-    /// size keeps the holes).
+    /// cell does; the others stay). With carving on ([`Mesher::carve_dropped_holes`]) the holes
+    /// narrower than [`Mesher::carve_islands`] cells are left out from the start and the
+    /// retries leave out wider ones, all carved back where they can be. With `false` every hole
+    /// stays in the layout and the run fails with the error naming the hole and the remedies (a
+    /// smaller cell size keeps the holes).
     pub fn drop_narrow_holes(mut self, yes: bool) -> Self {
         self.drop_narrow_holes = yes;
         self
     }
-    /// Whether the holes the narrow-hole retry of [`Mesher::drop_narrow_holes`] left out of the
-    /// layout are carved back into the smoothed mesh (default `true`): the cells covering each
+    /// Whether holes are carved at all (default `true`): those narrower than
+    /// [`Mesher::carve_islands`] cell sizes from the start, and those the retries of
+    /// [`Mesher::mesh_observed`] left out of the layout: the cells covering each
     /// such island are removed, the nodes around them moved onto its contour, and the mesh
     /// smoothed again ([`crate::carve`]). The islands carved are listed in
     /// [`MeshReport::holes_carved`], the others stay in [`MeshReport::holes_dropped`] and the
@@ -392,13 +404,17 @@ impl Mesher {
         self.carve_dropped = yes;
         self
     }
-    /// Leaves every hole narrower than `width` cell sizes out of the block layout from the start
-    /// and carves it into the smoothed mesh ([`crate::carve`]; default 0: only the retries of
-    /// [`Mesher::mesh_observed`] do, when bridging such holes fails or stays below the quality
-    /// target). For seas with many islands a few cells across, this skips the attempts that
-    /// bridge them. Applies with the default hole filter ([`HoleFilter::KeepAll`]) only; the
-    /// islands carved are listed in [`MeshReport::holes_carved`], those too small to carve in
-    /// [`MeshReport::holes_dropped`]. Negative or non-finite values are 0.
+    /// Leaves every hole narrower than `width` cell sizes ([`unamalla_contour::hole_width`]) out
+    /// of the block layout from the start and carves it into the smoothed mesh
+    /// ([`crate::carve`]); default [`DEFAULT_CARVE_WIDTH`] = 1: an island narrower than a cell
+    /// cannot be bridged by blocks of cells of that size (the cuts around it make blocks
+    /// thinner than a cell, whose counts force slivers). Wider holes are carved by the retries
+    /// of [`Mesher::mesh_observed`] when bridging them fails or stays below the quality target.
+    /// Applies with the default hole filter ([`HoleFilter::KeepAll`]) and while
+    /// [`Mesher::carve_dropped_holes`] and [`Mesher::drop_narrow_holes`] are on (an island too
+    /// small to carve is dropped); the islands carved are listed in
+    /// [`MeshReport::holes_carved`], those too small to carve in [`MeshReport::holes_dropped`].
+    /// 0 keeps every hole in the layout. Negative or non-finite values are 0.
     pub fn carve_islands(mut self, width: f64) -> Self {
         self.carve_width = if width.is_finite() {
             width.max(0.0)

@@ -28,6 +28,18 @@ impl Mesher {
         }
     }
 
+    /// The width below which the pipeline itself leaves holes out of the layout: 0 with the
+    /// default hole filter ([`HoleFilter::KeepAll`]), the width it set
+    /// ([`Mesher::carve_islands`] or a retry); `None` when the user set a hole filter (the
+    /// pipeline then leaves the holes alone) or the region is not simplified.
+    fn auto_drop_width(&self) -> Option<f64> {
+        match self.simplify.as_ref()?.holes {
+            HoleFilter::KeepAll => Some(0.0),
+            HoleFilter::MinWidth(w) if self.auto_dropped => Some(w),
+            _ => None,
+        }
+    }
+
     /// Pipeline steps 1 and 1b alone: the region simplified by the contour method
     /// ([`simplify_for_mesh`]) and then without the boundary features below the cell size
     /// ([`Mesher::feature_factor`]). The mesher meshes [`PreparedRegion::mesh_region`]; a
@@ -137,12 +149,11 @@ impl Mesher {
         )?;
         let allow = self.allow_non_convex;
         // islands carved from the start ([`Mesher::carve_islands`])
-        if self.carve_width > 0.0 && h > 0.0 {
+        if self.carve_dropped && self.drop_narrow_holes && self.carve_width > 0.0 && h > 0.0 {
             if let Some(o) = self.simplify.as_mut() {
                 if o.holes == HoleFilter::KeepAll {
                     o.holes = HoleFilter::MinWidth(self.carve_width * h);
                     self.auto_dropped = true;
-                    self.carve_dropped = true;
                 }
             }
         }
@@ -183,10 +194,7 @@ impl Mesher {
         // holes narrower than a cell: with the default hole filter, a failure next to such a
         // hole is meshed again without every hole narrower than h ([`Mesher::drop_narrow_holes`])
         if !allow && !v.passed() && self.drop_narrow_holes && h > 0.0 {
-            let default_filter = self
-                .simplify
-                .as_ref()
-                .is_some_and(|o| o.holes == HoleFilter::KeepAll);
+            let default_filter = self.auto_drop_width().is_some();
             let narrow = region
                 .holes()
                 .iter()
@@ -337,12 +345,10 @@ impl Mesher {
             && result.report.mu_ge_0_8_percent < self.quality_target
             && self.carve_dropped
             && self.drop_narrow_holes
-            && !self.auto_dropped
             && h > 0.0
             && self
-                .simplify
-                .as_ref()
-                .is_some_and(|o| o.holes == HoleFilter::KeepAll)
+                .auto_drop_width()
+                .is_some_and(|w| w < NEAR_HOLE_WIDTH * h)
         {
             let mut width = NEAR_HOLE_WIDTH * h;
             while width <= CARVE_MAX_WIDTH * h {
