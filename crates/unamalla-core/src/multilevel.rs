@@ -307,9 +307,9 @@ pub fn coarse_options(opts: &SmoothOptions) -> SmoothOptions {
 
 /// The options of the fine run from a prolonged start: `opts` without its σ continuation (the
 /// coarse levels already ran it; the start is a smoothed mesh at the final σ), and its
-/// convergence tests with the short window of a polish run ([`unamalla_optim::StopRules::polish`]:
-/// nested iteration leaves only the fine-scale error, which Newton removes in a few
-/// iterations).
+/// convergence tests with the short window FTOL of a polish run
+/// ([`unamalla_optim::StopRules::polish`]: nested iteration leaves only the fine-scale error,
+/// which Newton removes in a few iterations; the quality plateau keeps its window).
 pub fn polish_options(opts: &SmoothOptions) -> SmoothOptions {
     let mut o = opts.clone().sigma_continuation(Vec::new());
     o.solver.stop = o.solver.stop.polish();

@@ -24,6 +24,18 @@
 //! [`PatchReport::work_bound`]). The caps are iteration counts, not wall-clock time, so the
 //! result does not depend on the machine's load.
 //!
+//! **No window tests in a patch.** A patch run ends on its caps, GTOL and FTOL only: the window
+//! tests of the caller's options ([`unamalla_optim::StopRules`]) are turned off. They are made
+//! for the smoothing of the whole mesh, and on a patch both signals of the quality plateau are
+//! blind: its cells are folded or next to folds, far below μ = 0.8 (the μ ≥ 0.8 share of a
+//! gulf-of-mexico patch stayed at 5.8 % while the run went on), and α₋/ᾱ of a patch sits at the
+//! safeguard's floor ε, constant by construction. With them six gulf-of-mexico patch runs at
+//! 20,000 cells stopped on the plateau after 19–60 iterations, most with α₋/ᾱ at the floor;
+//! the global run started from there with α₋/ᾱ at the floor (1.0007·10⁻², against 1.57·10⁻²
+//! after the patches of the run to convergence, which has no window tests), and the mesh
+//! ended at 92.74 % μ ≥ 0.8 against 95.05 % converged; without them 94.75 % (`smooth_study`,
+//! docs/benchmarks.md, "Default smoothing against the converged optimum").
+//!
 //! **Observable.** [`untangle_patches_observed`] solves the patches in fixed batches of
 //! [`PATCH_BATCH`] (each batch in parallel; patches are disjoint, so the result does not depend
 //! on the batching or the thread count) and calls the observer after every batch with the
@@ -114,6 +126,8 @@ where
     popts.presmooth = 0;
     popts.solver.max_iter = PATCH_POLISH_ITER;
     popts.sigma_continuation.clear();
+    // no window tests in a patch (module docs)
+    popts.solver.stop = unamalla_optim::StopRules::default();
     let mut bad = non_convex_cells(mesh);
     let mut report = PatchReport {
         before: bad.len(),
@@ -390,6 +404,38 @@ mod tests {
         // spots — belongs to no patch and must not move
         assert!(r.max_radius <= 8, "{r:?}");
         assert_eq!(mesh.nodes()[at(19, 1)], start[at(19, 1)]);
+    }
+
+    /// The window tests of the caller's options do not reach the patch runs (module docs): rules
+    /// that would stop any run after two convex iterates (window 1, a window FTOL no decrease
+    /// passes, a plateau every spread passes) leave the untangled mesh identical, bit for bit,
+    /// to the one without rules.
+    #[test]
+    fn patch_runs_ignore_the_callers_window_tests() {
+        let n = 21;
+        let h = 1.0 / (n - 1) as f64;
+        let g = StructuredGrid2::from_fn(n, n, |i, j| DVec2::new(i as f64 * h, j as f64 * h))
+            .expect("grid");
+        let mut plain = QuadMesh::from_grid(&g);
+        plain.nodes_mut()[5 * n + 5] += DVec2::new(1.5 * h, 1.5 * h);
+        let mut ruled = plain.clone();
+        let opts = SmoothOptions::default();
+        let mut eager = opts.clone();
+        eager.solver.stop = unamalla_optim::StopRules {
+            window: 1,
+            window_ftol: 1e9,
+            plateau_alpha: 1e9,
+            plateau_share: 1e9,
+            plateau_window: 1,
+        };
+        let a = untangle_patches(&mut plain, &opts, &DEFAULT_PATCH_RADII).expect("untangle");
+        let b = untangle_patches(&mut ruled, &eager, &DEFAULT_PATCH_RADII).expect("untangle");
+        assert_eq!(a.after, 0);
+        assert_eq!(
+            (a.after, a.patches, a.iterations),
+            (b.after, b.patches, b.iterations)
+        );
+        assert_eq!(plain.nodes(), ruled.nodes());
     }
 
     /// A patch whose fixed nodes enclose a negative area (here the whole mesh is a mirrored

@@ -150,6 +150,6 @@ pub use safeguard::{Convexity, Session};
 pub use shape::{improve_shape, BoundarySlide, ShapeOptions, ShapeReport};
 pub use solver::{
     minimize, HessianMode, PointwiseMode, SolveResult, Solver, SolverOptions, StopRules,
-    POLISH_WINDOW,
+    POLISH_WINDOW, REGROWTH_FACTOR,
 };
 pub use status::{LineSearchFailure, Status, StopReason};

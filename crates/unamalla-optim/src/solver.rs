@@ -36,7 +36,9 @@ mod newton;
 mod options;
 mod pointwise;
 
-pub use options::{HessianMode, PointwiseMode, Solver, SolverOptions, StopRules, POLISH_WINDOW};
+pub use options::{
+    HessianMode, PointwiseMode, Solver, SolverOptions, StopRules, POLISH_WINDOW, REGROWTH_FACTOR,
+};
 pub use pointwise::QuadLocalGuard;
 
 use lbfgs::lbfgs;
@@ -226,9 +228,9 @@ impl State {
                 if let Some(r) = opts.stop.check(&self.history) {
                     return Some(r);
                 }
-                if self.history.len() > 4 * opts.stop.window {
-                    self.history
-                        .drain(..self.history.len() - opts.stop.window - 1);
+                let keep = opts.stop.history_len();
+                if self.history.len() > 4 * keep {
+                    self.history.drain(..self.history.len() - keep);
                 }
             }
         }

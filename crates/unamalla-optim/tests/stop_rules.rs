@@ -25,6 +25,14 @@ fn opts(stop: StopRules, max_iter: usize) -> SmoothOptions {
     )
 }
 
+/// Whether the per-iteration decrease of `f` grew by half again twice up to iterate `i`
+/// (`d_i ≥ 1.5·d_{i−1} ≥ 1.5²·d_{i−2} > 0`, `d_j = f_{j−1} − f_j`): the regrowth guard of the
+/// window tests, written out.
+fn growing(f: &[f64], i: usize) -> bool {
+    let d = |j: usize| f[j - 1] - f[j];
+    i >= 3 && d(i - 2) > 0.0 && d(i - 1) >= 1.5 * d(i - 2) && d(i) >= 1.5 * d(i - 1)
+}
+
 fn grid() -> StructuredGrid2 {
     sinusoidal(21, 21, 0.08, 2.0).unwrap()
 }
@@ -52,12 +60,12 @@ fn window_ftol_stops_where_the_rule_applied_to_the_free_run_says() {
     );
     let w = 5;
     let tol = 1e-4;
-    // first accepted iterate k (1-based) with F_{k−w} − F_k ≤ tol·|F_k| (all iterates are
-    // convex: the start is ε-convex and the safeguard keeps it so)
+    // first accepted iterate k (1-based) with F_{k−w} − F_k ≤ tol·|F_k| and F's decrease not
+    // regrowing (all iterates are convex: the start is ε-convex and the safeguard keeps it so)
     let f: Vec<f64> = free.iter().map(|m| m.f).collect();
     assert!(free.iter().all(|m| m.inocon == 0));
     let k = (w..f.len())
-        .find(|&i| f[i - w] - f[i] <= tol * f[i].abs())
+        .find(|&i| f[i - w] - f[i] <= tol * f[i].abs() && !growing(&f, i))
         .expect("the free run must flatten out within 60 iterations")
         + 1;
     assert!(
@@ -121,8 +129,12 @@ fn quality_plateau_stops_where_alpha_and_the_mu_share_stop_moving() {
         v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
             - v.iter().cloned().fold(f64::INFINITY, f64::min)
     };
+    let f: Vec<f64> = free.iter().map(|m| m.f).collect();
     let k = (w..n)
         .find(|&i| {
+            if growing(&f, i) {
+                return false;
+            }
             let qs = &q[i - w..=i];
             let qmax = qs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
             spread(qs) <= pa * qmax && spread(&share[i - w..=i]) <= ps
@@ -162,6 +174,7 @@ fn stop_rules_check_by_hand() {
         window_ftol: 0.1,
         plateau_alpha: 0.0,
         plateau_share: 0.0,
+        plateau_window: 0,
     };
     // F: 10, 9, 8.5: over two iterations 1.5 > 0.1·8.5 = 0.85 → go on; then 8.2: 0.8 ≤ 0.82
     let h = |f: &[f64]| f.iter().map(|&f| (f, 0.1, None)).collect::<Vec<_>>();
@@ -176,6 +189,7 @@ fn stop_rules_check_by_hand() {
         window_ftol: 0.0,
         plateau_alpha: 0.01,
         plateau_share: 0.1,
+        plateau_window: 0,
     };
     // α₋/ᾱ within 1 % of its max, share within 0.1 points → plateau; a share jump of 0.2 → not
     let flat = [
@@ -199,6 +213,103 @@ fn stop_rules_check_by_hand() {
     // without a quality probe the plateau test cannot fire
     let no_probe = [(5.0, 0.2, None), (4.0, 0.2, None), (3.0, 0.2, None)];
     assert_eq!(p.check(&no_probe), None);
+}
+
+/// The default rules (`unamalla_core::pipeline::DEFAULT_STOP_RULES`) on a stretch like the one
+/// the gulf-of-mexico run at 20,000 cells stopped in: a step cut by the safeguard shrank the trust
+/// radius from 1.39 to 7.9·10⁻⁶, and the radius then doubles after each step, so the decrease of
+/// F per iteration doubles (6.6·10⁻⁷, 1.0·10⁻⁶, 2.0·10⁻⁶, …) while α₋/ᾱ stays at the floor and the
+/// μ ≥ 0.8 share does not move. The old plateau (spreads only) fired there; now no test fires
+/// until the decrease stops growing.
+#[test]
+fn no_window_test_fires_while_the_trust_region_regrows() {
+    let rules = StopRules {
+        window: 10,
+        window_ftol: 1e-4,
+        plateau_alpha: 0.01,
+        plateau_share: 0.05,
+        plateau_window: 10,
+    };
+    // F_0 = 1.45, decreases d_i = 10⁻⁶·2^(i−1), i = 1..10: over the window F falls by
+    // 10⁻⁶·(2¹⁰ − 1) = 1.023·10⁻³ > 10⁻⁴·1.449 (no window FTOL); α₋/ᾱ = 0.01 and the share
+    // 92.9 % throughout (spreads 0: the plateau's spreads alone are met)
+    let mut f = vec![1.45];
+    for i in 1..=10 {
+        let d = 1e-6 * f64::powi(2.0, i - 1);
+        f.push(f[f.len() - 1] - d);
+    }
+    let hist: Vec<(f64, f64, Option<f64>)> = f.iter().map(|&f| (f, 0.01, Some(92.9))).collect();
+    assert_eq!(hist.len(), 11);
+    assert!(hist[0].0 - hist[10].0 > 1e-4 * hist[10].0);
+    assert!(StopRules::regrowing(&hist));
+    assert_eq!(rules.check(&hist), None, "regrowing: no test fires");
+    // what the rule without the regrowth guard said: the spreads are within the thresholds
+    let old = |h: &[(f64, f64, Option<f64>)]| {
+        let w = &h[h.len() - 11..];
+        let qs = w.iter().map(|x| x.1);
+        let ss = w.iter().map(|x| x.2.unwrap());
+        let spread = |v: &mut dyn Iterator<Item = f64>| {
+            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+            hi - lo
+        };
+        spread(&mut qs.clone()) <= 0.01 * 0.01 && spread(&mut ss.clone()) <= 0.05
+    };
+    assert!(old(&hist), "the old plateau fired here");
+    // the growth stops (the next decrease is 0.9 of the last, 5.12·10⁻⁴·0.9): the plateau fires
+    let mut stopped = hist.clone();
+    let last = stopped[10].0;
+    stopped.push((last - 0.9 * 5.12e-4, 0.01, Some(92.9)));
+    assert!(!StopRules::regrowing(&stopped));
+    assert_eq!(rules.check(&stopped), Some(StopReason::Plateau));
+    // a share that moves by a cell in between (0.005 points) is still a plateau, one that moves by
+    // 0.06 points over the window is not
+    let mut moved = stopped.clone();
+    moved[5].2 = Some(92.905);
+    assert_eq!(rules.check(&moved), Some(StopReason::Plateau));
+    moved[11].2 = Some(92.96);
+    assert_eq!(rules.check(&moved), None);
+}
+
+/// A polish run (`StopRules::polish` of the default rules: window FTOL over 2 iterations, 2·10⁻⁵)
+/// keeps the plateau's window of 10 and its 0.05 points: three iterates whose shares agree within
+/// one cell (0.005 points at 20,000 cells) while F still falls by 10⁻⁴ per iteration are no
+/// plateau (the scaled rule, 0.01 points over 3 iterates, fired there — quintana-roo's polish run
+/// at 20,000 cells stopped so at 98.46 % against 98.91 % converged).
+#[test]
+fn a_polish_run_keeps_the_plateau_window() {
+    let p = StopRules {
+        window: 10,
+        window_ftol: 1e-4,
+        plateau_alpha: 0.01,
+        plateau_share: 0.05,
+        plateau_window: 0,
+    }
+    .polish();
+    assert_eq!((p.window, p.plateau_len(), p.history_len()), (2, 10, 11));
+    // F = 1.1220, 1.1219, 1.1218 (relative decrease over two iterations 1.8·10⁻⁴ > 2·10⁻⁵);
+    // shares 97.400, 97.405, 97.400; α₋/ᾱ at its floor 0.01
+    let three = [
+        (1.1220, 0.01, Some(97.4)),
+        (1.1219, 0.01, Some(97.405)),
+        (1.1218, 0.01, Some(97.4)),
+    ];
+    assert!(!StopRules::regrowing(&three));
+    assert_eq!(p.check(&three), None, "no plateau on three iterates");
+    // eleven iterates, F falling by 10⁻⁴ each, shares within 0.05 points: the plateau fires
+    let eleven: Vec<(f64, f64, Option<f64>)> = (0..11)
+        .map(|i| {
+            let s = if i % 2 == 0 { 97.4 } else { 97.43 };
+            (1.1220 - 1e-4 * i as f64, 0.01, Some(s))
+        })
+        .collect();
+    assert_eq!(p.check(&eleven), Some(StopReason::Plateau));
+    // and the window FTOL still reads two iterations: F flat over the last two fires it
+    let mut flat = three.to_vec();
+    flat.push((1.1218, 0.01, Some(97.5)));
+    flat.push((1.1218, 0.01, Some(97.6)));
+    assert_eq!(p.check(&flat), Some(StopReason::WindowFtol));
 }
 
 #[test]

@@ -565,10 +565,15 @@ pub fn default_smooth_options() -> SmoothOptions {
 
 /// The convergence tests of the pipeline's smoothing ([`unamalla_optim::StopRules`]): over a
 /// window of 10 iterations, F decreased by less than 10⁻⁴ relative, or α₋/ᾱ moved by less than
-/// 1 % and the μ ≥ 0.8 share by less than 0.05 points.
+/// 1 % and the μ ≥ 0.8 share by less than 0.05 points; neither while F's decrease per
+/// iteration grows geometrically (the trust region regrowing after a step cut by the
+/// safeguard, [`unamalla_optim::StopRules::regrowing`]). Polish runs shorten the window of F to
+/// [`unamalla_optim::POLISH_WINDOW`] and keep the plateau's ([`unamalla_optim::StopRules::polish`]);
+/// untangling patches run without these tests ([`crate::untangle`]).
 pub const DEFAULT_STOP_RULES: unamalla_optim::StopRules = unamalla_optim::StopRules {
     window: 10,
     window_ftol: 1e-4,
     plateau_alpha: 0.01,
     plateau_share: 0.05,
+    plateau_window: 10,
 };
