@@ -197,11 +197,13 @@ fn a_failure_next_to_holes_narrower_than_a_cell_is_meshed_without_them() {
 }
 
 /// A sea of 500 islands 0.5–1.6 cell sizes across (synthetic: a 200 × 120 box, five chains)
-/// at 20,000 cells. Without the 273 islands narrower than a cell the layouts still leave a
-/// cell folded next to an island between one and two cells across; the later round leaves out
-/// the islands narrower than `NEAR_HOLE_WIDTH` cells next to the failure (not all of them):
-/// the mesh is made, passes the independent check, and every dropped hole is either narrower
-/// than a cell or narrower than two and named in a note. (With carving off: by default the
+/// at 20,000 cells, with carving off. The mesh keeping every island fails; it is made again
+/// without the islands narrower than a cell, and where that still leaves a cell folded next to
+/// an island between one and two cells across, a later round leaves out the islands narrower
+/// than `NEAR_HOLE_WIDTH` cells next to the failure (not all of them; measured with the
+/// bounding-box width of the fourth session: 1 of 189; with the hull width no later round is
+/// needed): the mesh is made, passes the independent check, and every dropped hole is either
+/// narrower than a cell or narrower than two and named in a note. (With carving off: by default the
 /// islands are carved, `a_sea_of_islands_is_meshed_with_its_islands_carved`.)
 #[test]
 #[ignore = "meshes a 500-island sea about nine times (≈ 90 s in release): \
@@ -230,21 +232,24 @@ fn a_sea_of_islands_one_or_two_cells_across_is_meshed() {
     assert!(v.passed(), "{v}");
     assert_eq!(r.report.interior_singularities, 0);
     let dropped = &r.report.holes_dropped;
-    // every hole narrower than a cell, and some (not all) of those one to two cells across
+    // every hole narrower than a cell, and of those one to two cells across only some (those
+    // next to which a later round still failed, each round named in a note; none when the
+    // mesh without the narrower ones passes)
     assert_eq!(dropped.iter().filter(|&&k| width(k) < h).count(), narrow);
     let later = dropped.iter().filter(|&&k| width(k) >= h).count();
-    assert!(later > 0 && later < near_scale, "{later} of {near_scale}");
+    assert!(later < near_scale, "{later} of {near_scale}");
     assert!(dropped.iter().all(|&k| width(k) < NEAR_HOLE_WIDTH * h));
     assert_eq!(
         r.simplified.holes().len(),
         reg.holes().len() - dropped.len()
     );
-    assert!(
+    assert_eq!(
+        later > 0,
         r.report
             .notes
             .iter()
             .any(|n| n.contains("narrower than 2 cell sizes")),
-        "{:?}",
+        "{later} dropped in later rounds; notes {:?}",
         r.report.notes
     );
 }

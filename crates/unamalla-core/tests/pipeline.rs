@@ -147,8 +147,14 @@ fn gulf_of_mexico_with_its_sliver_island_is_convex_and_smoothed() {
     // ended with the smoothing stuck in a non-convex state (μ ≥ 0.8 on 69.9 % of the cells,
     // 2026-11-22); it is deterministic here (the global run stops by FTOL well inside its
     // time budget).
+    // (with every island in the block layout: by default the islands narrower than a cell
+    // are carved instead, checked below)
     let region = load("gulf-of-mexico.geojson");
-    let r = Mesher::new().cells(6_000).mesh(&region).unwrap();
+    let r = Mesher::new()
+        .cells(6_000)
+        .carve_dropped_holes(false)
+        .mesh(&region)
+        .unwrap();
     check(&r, region.holes().len());
     assert!(
         r.report.smoothing.starts_with("Convex grid"),
@@ -161,6 +167,32 @@ fn gulf_of_mexico_with_its_sliver_island_is_convex_and_smoothed() {
         r.report.mu_ge_0_8_percent
     );
     assert!(r.report.area_change_percent <= 2.0);
+    // by default: every island narrower than a cell leaves the layout and is carved, or
+    // dropped when it cannot be; the others stay; the mesh is all-convex without interior
+    // singularities and its boundary loops are the meshed region's rings
+    let d = Mesher::new().cells(6_000).mesh(&region).unwrap();
+    let h = (region.area() / 6_000.0).sqrt();
+    let width = |k: usize| unamalla_core::contour::hole_width(&region.holes()[k]);
+    let mut out: Vec<usize> = d
+        .report
+        .holes_carved
+        .iter()
+        .chain(&d.report.holes_dropped)
+        .copied()
+        .collect();
+    out.sort_unstable();
+    let narrow: Vec<usize> = (0..region.holes().len())
+        .filter(|&k| width(k) < h)
+        .collect();
+    assert_eq!(out, narrow);
+    assert_eq!(
+        d.simplified.holes().len(),
+        region.holes().len() - d.report.holes_dropped.len()
+    );
+    assert_eq!(d.report.non_convex_cells, 0);
+    assert_eq!(d.report.interior_singularities, 0);
+    let loops = io::msh::boundary_loops(d.mesh.global());
+    assert_eq!(loops.len(), 1 + d.simplified.holes().len());
 }
 
 /// The quality targets as a test: every bundled region at the default size (about 20,000
