@@ -35,7 +35,8 @@ pub const NEAR_HOLE_WIDTH: f64 = 2.0;
 /// instead of bridging it with cuts. The narrow-hole retry and the carving retry of
 /// [`Mesher::mesh_observed`] first leave the holes narrower than [`NEAR_HOLE_WIDTH`] cell sizes
 /// out of the layout; when the block decomposition still finds no admissible cuts around the
-/// rest (a sea of islands two to three cells across), the width doubles up to this one. A
+/// rest, or (the quality retry) the mesh bridging the rest stays below the one it would
+/// replace (a sea of islands two to three cells across), the width doubles up to this one. A
 /// carved hole is a rectangle of cells whose ring of nodes moves onto the island's contour; up
 /// to four cells across its corner cells still keep convex angles near 135° around a round
 /// island, while larger islands get blocks of their own.

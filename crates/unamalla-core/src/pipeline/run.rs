@@ -338,7 +338,8 @@ impl Mesher {
         // target, in a region with holes narrower than NEAR_HOLE_WIDTH · h (the layout gives each
         // blocks a cell or two thick), is made once more with those holes left out of the layout
         // and carved back into the mesh ([`Mesher::carve_dropped_holes`]), and kept if it passes
-        // with a higher share
+        // with a higher share; if it does not (or the decomposition finds no cuts around the
+        // holes left), once more with the holes twice as wide, up to CARVE_MAX_WIDTH · h
         if !allow
             && v.passed()
             && self.quality_target > 0.0
@@ -398,8 +399,10 @@ impl Mesher {
                         if kept {
                             result = retry;
                             v = rv;
+                            break;
                         }
-                        break;
+                        // the islands left in the layout still keep it below: carve wider ones
+                        width *= 2.0;
                     }
                     // the decomposition found no cuts around the holes left: carve wider ones
                     Err(e) => {
