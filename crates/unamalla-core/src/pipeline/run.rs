@@ -149,11 +149,20 @@ impl Mesher {
         )?;
         let allow = self.allow_non_convex;
         // islands carved from the start ([`Mesher::carve_islands`])
+        // (the number of holes it leaves out of the layout)
+        let mut carved_from_start = 0;
         if self.carve_dropped && self.drop_narrow_holes && self.carve_width > 0.0 && h > 0.0 {
+            let width = self.carve_width * h;
             if let Some(o) = self.simplify.as_mut() {
-                if o.holes == HoleFilter::KeepAll {
-                    o.holes = HoleFilter::MinWidth(self.carve_width * h);
+                let narrow = region
+                    .holes()
+                    .iter()
+                    .filter(|hole| unamalla_contour::hole_width(hole) < width)
+                    .count();
+                if o.holes == HoleFilter::KeepAll && narrow > 0 {
+                    o.holes = HoleFilter::MinWidth(width);
                     self.auto_dropped = true;
+                    carved_from_start = narrow;
                 }
             }
         }
@@ -191,6 +200,32 @@ impl Mesher {
         let mut last;
         ((result, v), last) =
             self.layout_fallback(region, observer, &verify, (result, v), &mut failed);
+        // carving from the start changed the layout (the narrow holes are not in it); when
+        // that mesh fails the guarantee, the mesh keeping every hole in the layout is made too
+        // and kept if it has fewer bad cells
+        if !allow && !v.passed() && carved_from_start > 0 {
+            let note = format!(
+                "the mesh with the {carved_from_start} hole(s) narrower than {} cell size(s) left out of the layout failed the guarantee; made again with every hole in the layout",
+                self.carve_width
+            );
+            self.stage(Stage::Decompose, &note);
+            failed.push(note);
+            if let Some(o) = self.simplify.as_mut() {
+                o.holes = HoleFilter::KeepAll;
+            }
+            self.auto_dropped = false;
+            self.excluded_layouts.clear();
+            if let Ok(retry) = self.mesh_unverified(region, observer) {
+                let rv = verify(&retry);
+                let ((retry, rv), retry_last) =
+                    self.layout_fallback(region, observer, &verify, (retry, rv), &mut failed);
+                if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
+                    result = retry;
+                    v = rv;
+                    last = retry_last;
+                }
+            }
+        }
         // holes narrower than a cell: with the default hole filter, a failure next to such a
         // hole is meshed again without every hole narrower than h ([`Mesher::drop_narrow_holes`])
         if !allow && !v.passed() && self.drop_narrow_holes && h > 0.0 {
