@@ -245,7 +245,7 @@ fn hole_width_is_the_minimum_width_of_the_hull() {
         .collect();
     let w = unamalla_contour::hole_width(&unamalla_mesh::Polygon::new(rect).unwrap());
     assert!((w - 0.5).abs() < 1e-12, "{w}");
-    for t0 in [0.0, 0.1, 0.3927] {
+    for t0 in [0.0, 0.1, std::f64::consts::FRAC_PI_8] {
         let oct: Vec<DVec2> = (0..8)
             .map(|k| {
                 let t = t0 + std::f64::consts::FRAC_PI_4 * k as f64;
