@@ -111,6 +111,8 @@ pub enum CarveOutcome {
 pub struct Carved {
     /// The carved mesh (the blocks holding islands split around them).
     pub mesh: BlockMesh2,
+    /// For each block of the carved mesh, the block of the input mesh it is part of.
+    pub origin: Vec<usize>,
     /// Per island, in the order given: its id and what happened to it.
     pub outcomes: Vec<(usize, CarveOutcome)>,
 }
@@ -141,6 +143,8 @@ struct Piece {
     m: usize,
     n: usize,
     ids: Vec<usize>,
+    /// The block of the input mesh this piece is part of.
+    origin: usize,
 }
 
 impl Piece {
@@ -157,6 +161,7 @@ impl Piece {
             m: i1 - i0 + 1,
             n: j1 - j0 + 1,
             ids,
+            origin: self.origin,
         }
     }
 }
@@ -180,6 +185,7 @@ pub fn carve_islands(
             m: g.m(),
             n: g.n(),
             ids: mesh.block_node_map(b).to_vec(),
+            origin: b,
         })
         .collect();
     let mut outcomes = Vec::with_capacity(islands.len());
@@ -231,7 +237,12 @@ pub fn carve_islands(
         .map(|p| StructuredGrid2::new(p.m, p.n, p.ids.iter().map(|&g| pos[g]).collect()))
         .collect::<Result<Vec<_>, _>>()?;
     let mesh = BlockMesh2::merge(grids, 1e-9)?;
-    Ok(Carved { mesh, outcomes })
+    let origin = pieces.iter().map(|p| p.origin).collect();
+    Ok(Carved {
+        mesh,
+        origin,
+        outcomes,
+    })
 }
 
 /// Step 1 of the module docs: the piece and the inclusive cell ranges `(i₀, i₁), (j₀, j₁)` to

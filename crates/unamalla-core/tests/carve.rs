@@ -89,6 +89,13 @@ fn islands_narrower_than_two_cells_are_carved_onto_their_contours() {
             assert!(nodes.contains(&p), "{p} is not a mesh node");
         }
     }
+    // the report's per-block quality covers the layout's blocks, each with the cells of the
+    // pieces it was split into around the islands: every cell counted once
+    let layout_blocks = r.report.layout.as_ref().map_or(0, |l| l.blocks.len());
+    assert!(layout_blocks > 0 && layout_blocks < r.report.blocks);
+    assert_eq!(r.report.block_quality.len(), layout_blocks);
+    let counted: usize = r.report.block_quality.iter().map(|b| b.cells).sum();
+    assert_eq!(counted, r.report.cells);
     // the request is honoured (±15 %)
     let cells = r.report.cells as f64;
     assert!((cells / 1_600.0 - 1.0).abs() <= 0.15, "{cells}");

@@ -71,6 +71,7 @@ fn a_two_by_two_island_becomes_a_hole_on_its_contour() {
     assert_eq!(c.mesh.global().num_quads(), 32);
     assert_eq!(c.mesh.global().nodes().len(), 48);
     assert_eq!(c.mesh.blocks().len(), 8);
+    assert_eq!(c.origin, vec![0; 8]);
     // every interior node keeps four cells; the hole's nodes are boundary nodes (and fixed)
     let v = valences(&c.mesh);
     assert!(v.iter().all(|&(interior, n)| !interior || n == 4), "{v:?}");

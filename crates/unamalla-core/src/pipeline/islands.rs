@@ -13,6 +13,8 @@ pub(super) struct CarveStep {
     pub region: Region,
     /// The input holes carved, sorted.
     pub carved: Vec<usize>,
+    /// For each block of `mesh`, the block of the uncarved mesh it is part of.
+    pub origin: Vec<usize>,
 }
 
 /// What [`Mesher::carve_dropped`] carves: the input region, the region the mesh was made of
@@ -86,6 +88,7 @@ impl Mesher {
                     _ => 0,
                 })
                 .sum();
+            let origin = c.origin;
             let mut carved_mesh = c.mesh;
             let polish = crate::multilevel::polish_options(sopts);
             self.untangle_and_smooth(&mut carved_mesh, &polish, t_stage, observer)?;
@@ -102,6 +105,7 @@ impl Mesher {
                     mesh: carved_mesh,
                     region,
                     carved,
+                    origin,
                 };
                 return Ok((Some(step), note));
             }

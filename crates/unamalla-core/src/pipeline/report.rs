@@ -70,7 +70,8 @@ pub struct MeshReport {
 pub struct BlockQuality {
     /// Block id.
     pub block: usize,
-    /// Cells of the block in the final mesh.
+    /// Cells of the block in the final mesh (of the pieces it was split into around carved
+    /// islands, [`MeshReport::holes_carved`]).
     pub cells: usize,
     /// Predicted μ ≥ 0.8 percentage ([`crate::predict`]).
     pub predicted: f64,

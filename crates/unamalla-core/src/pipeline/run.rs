@@ -598,6 +598,8 @@ impl Mesher {
         // the dropped holes carved back in (step 7b′) and the note saying so
         let mut holes_carved: Vec<usize> = Vec::new();
         let mut carve_notes: Vec<String> = Vec::new();
+        // with islands carved: the block of the layout each block of the mesh is part of
+        let mut block_origin: Option<Vec<usize>> = None;
         let neck_notes: Vec<String> = prepared.necks.iter().map(|c| c.to_string()).collect();
         // a decomposition file fits either region: ours (saved by a previous run) fits the one
         // without features, one made by hand for the simplified region fits the other
@@ -767,6 +769,7 @@ impl Mesher {
                 self.stage(Stage::Smooth, &note);
                 carve_notes.push(note);
                 if let Some(c) = step {
+                    block_origin = Some(c.origin);
                     mesh = c.mesh;
                     simplified = c.region;
                     holes_dropped.retain(|k| c.carved.binary_search(k).is_err());
@@ -841,18 +844,31 @@ impl Mesher {
             block_quality: layout_choice
                 .as_ref()
                 .map(|c| {
+                    // the mesh blocks of each layout block (one, or the pieces around its
+                    // carved islands)
+                    let parts = |b: usize| -> Vec<usize> {
+                        match &block_origin {
+                            None if b < mesh.blocks().len() => vec![b],
+                            None => Vec::new(),
+                            Some(o) => (0..o.len()).filter(|&k| o[k] == b).collect(),
+                        }
+                    };
                     c.blocks
                         .iter()
                         .enumerate()
-                        .filter(|(b, _)| *b < mesh.blocks().len())
-                        .map(|(b, &p)| {
-                            let (a, cells) = crate::predict::block_good_share(&mesh, b);
-                            BlockQuality {
+                        .filter_map(|(b, &p)| {
+                            let (mut good, mut cells) = (0.0, 0);
+                            for k in parts(b) {
+                                let (a, n) = crate::predict::block_good_share(&mesh, k);
+                                good += a * n as f64;
+                                cells += n;
+                            }
+                            (cells > 0).then(|| BlockQuality {
                                 block: b,
                                 cells,
                                 predicted: 100.0 * p,
-                                achieved: 100.0 * a,
-                            }
+                                achieved: 100.0 * good / cells as f64,
+                            })
                         })
                         .collect()
                 })
