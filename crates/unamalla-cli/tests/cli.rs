@@ -472,3 +472,64 @@ fn strict_exits_3_on_a_missed_target_after_writing() {
     assert!(dir.join("strict").join("mesh.vtu").exists());
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// `--carve-islands` / `--no-carve`: a 200 × 200 square sea with one octagonal islet of
+/// circumradius 2 (width 2 · 2 · cos 22.5° ≈ 3.7, area 8√2 ≈ 11.3) at 1,600 cells (h = 5): the
+/// islet is narrower than a cell and at least a quarter of one in area, so by default it is
+/// carved (report.json "holes_carved" = [0]); `--no-carve` keeps it in the block layout (nothing
+/// carved); both flags together are refused.
+#[test]
+fn islets_are_carved_by_default_and_not_with_no_carve() {
+    let dir = tmpdir("carve");
+    let ring = |pts: Vec<(f64, f64)>| {
+        let mut v: Vec<[f64; 2]> = pts.into_iter().map(|(x, y)| [x, y]).collect();
+        v.push(v[0]);
+        v
+    };
+    let outer = ring(vec![(0.0, 0.0), (200.0, 0.0), (200.0, 200.0), (0.0, 200.0)]);
+    let islet = ring(
+        (0..8)
+            .rev()
+            .map(|k| {
+                let t = std::f64::consts::PI * (0.125 + k as f64 / 4.0);
+                (100.0 + 2.0 * t.cos(), 100.0 + 2.0 * t.sin())
+            })
+            .collect(),
+    );
+    let geo = serde_json::json!({
+        "type": "Feature",
+        "properties": {},
+        "geometry": {"type": "Polygon", "coordinates": [outer, islet]}
+    });
+    let input = dir.join("sea.geojson");
+    std::fs::write(&input, geo.to_string()).unwrap();
+    let run = |extra: &[&str], out: &str| {
+        let out = dir.join(out);
+        bin()
+            .arg("mesh")
+            .arg(&input)
+            .args([
+                "--crs", "planar", "--cells", "1600", "--quiet", "--export", "none", "-o",
+            ])
+            .arg(&out)
+            .args(extra)
+            .run_ok();
+        report(&out)
+    };
+    let carved = run(&[], "default");
+    assert_eq!(carved["holes_carved"], serde_json::json!([0]));
+    assert_eq!(carved["holes_dropped"], serde_json::json!([]));
+    assert_eq!(carved["non_convex_cells"], 0);
+    let kept = run(&["--no-carve"], "no-carve");
+    assert_eq!(kept["holes_carved"], serde_json::json!([]));
+    let both = bin()
+        .arg("mesh")
+        .arg(&input)
+        .args(["--carve-islands", "2", "--no-carve", "-o"])
+        .arg(dir.join("both"))
+        .output()
+        .unwrap();
+    assert!(!both.status.success());
+    assert!(!dir.join("both").exists());
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -63,7 +63,7 @@ pub const OFFSET_SAMPLES: usize = 256;
 pub enum CarveSkip {
     /// No cell's centroid lies in the island and its area is below [`MIN_AREA_FRACTION`] of
     /// the cell containing its centroid.
-    BelowHalfCell,
+    BelowMinArea,
     /// No cell of the mesh contains the island's centroid.
     OutsideMesh,
     /// The rectangle of cells covering the island is more than [`MAX_COVER_RATIO`] times the
@@ -79,7 +79,7 @@ pub enum CarveSkip {
 impl std::fmt::Display for CarveSkip {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
-            CarveSkip::BelowHalfCell => "smaller than a quarter of the cell containing it",
+            CarveSkip::BelowMinArea => "smaller than a quarter of the cell containing it",
             CarveSkip::OutsideMesh => "outside the mesh",
             CarveSkip::NotCompact => {
                 "thin across the grid: its cells cover more than 2.5 times its area"
@@ -298,7 +298,7 @@ fn cells_of(
     let small = if best.is_some() {
         CarveSkip::NotCompact
     } else {
-        CarveSkip::BelowHalfCell
+        CarveSkip::BelowMinArea
     };
     let c = area_centroid(island.points());
     for (b, p) in pieces.iter().enumerate() {

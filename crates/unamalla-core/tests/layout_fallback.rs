@@ -20,6 +20,16 @@ fn region(name: &str) -> unamalla_core::mesh::Region {
     io::read_region_geojson(p, PartSelector::Largest).unwrap()
 }
 
+/// The independent check of the mesh against the region it was made of passes.
+fn assert_verified(r: &unamalla_core::pipeline::MeshResult) {
+    let v = verify_quads(
+        r.mesh.global(),
+        Some(&r.simplified),
+        &VerifyOptions::default(),
+    );
+    assert!(v.passed(), "{v}");
+}
+
 #[test]
 fn a_layout_that_leaves_folds_is_replaced_by_the_next_candidate() {
     let r = Mesher::new()
@@ -27,12 +37,7 @@ fn a_layout_that_leaves_folds_is_replaced_by_the_next_candidate() {
         .mesh(&region("newfoundland"))
         .expect("a valid mesh from some candidate layout");
     assert_eq!(non_convex_cells(r.mesh.global()).len(), 0);
-    let v = verify_quads(
-        r.mesh.global(),
-        Some(&r.simplified),
-        &VerifyOptions::default(),
-    );
-    assert!(v.passed(), "{v}");
+    assert_verified(&r);
     let layout = r
         .report
         .layout
@@ -188,12 +193,7 @@ fn a_failure_next_to_holes_narrower_than_a_cell_is_meshed_without_them() {
         "{:?}",
         r.report.notes
     );
-    let v = verify_quads(
-        r.mesh.global(),
-        Some(&r.simplified),
-        &VerifyOptions::default(),
-    );
-    assert!(v.passed(), "{v}");
+    assert_verified(&r);
 }
 
 /// A sea of 500 islands 0.5–1.6 cell sizes across (synthetic: a 200 × 120 box, five chains)
@@ -224,12 +224,7 @@ fn a_sea_of_islands_one_or_two_cells_across_is_meshed() {
         .carve_dropped_holes(false)
         .mesh(&reg)
         .expect("the sea is meshed");
-    let v = verify_quads(
-        r.mesh.global(),
-        Some(&r.simplified),
-        &VerifyOptions::default(),
-    );
-    assert!(v.passed(), "{v}");
+    assert_verified(&r);
     assert_eq!(r.report.interior_singularities, 0);
     let dropped = &r.report.holes_dropped;
     // every hole narrower than a cell, and of those one to two cells across only some (those
@@ -271,12 +266,7 @@ fn a_sea_of_islands_is_meshed_with_its_islands_carved() {
         .cells(20_000)
         .mesh(&reg)
         .expect("the sea is meshed");
-    let v = verify_quads(
-        r.mesh.global(),
-        Some(&r.simplified),
-        &VerifyOptions::default(),
-    );
-    assert!(v.passed(), "{v}");
+    assert_verified(&r);
     assert_eq!(r.report.interior_singularities, 0);
     let (carved, dropped) = (&r.report.holes_carved, &r.report.holes_dropped);
     assert_eq!(carved.len() + dropped.len(), 500);
@@ -318,12 +308,7 @@ fn a_failure_after_carving_from_the_start_is_meshed_with_every_hole_in_the_layou
         .cells(100_000)
         .mesh(&reg)
         .expect("a valid mesh");
-    let v = verify_quads(
-        r.mesh.global(),
-        Some(&r.simplified),
-        &VerifyOptions::default(),
-    );
-    assert!(v.passed(), "{v}");
+    assert_verified(&r);
     assert_eq!(non_convex_cells(r.mesh.global()).len(), 0);
     assert!(
         r.report

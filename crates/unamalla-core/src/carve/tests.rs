@@ -106,7 +106,7 @@ fn an_island_smaller_than_a_cell_takes_the_cell_of_its_centroid_if_it_is_a_quart
     ));
     assert_eq!(
         c.outcomes[1].1,
-        CarveOutcome::Skipped(CarveSkip::BelowHalfCell)
+        CarveOutcome::Skipped(CarveSkip::BelowMinArea)
     );
     // one cell less, no node less (the four corners become the hole's ring)
     assert_eq!(c.mesh.global().num_quads(), 35);

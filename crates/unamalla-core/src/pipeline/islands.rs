@@ -142,8 +142,9 @@ impl Mesher {
             self.stage(Stage::Smooth, &msg);
         }
         let note = format!(
-            "the {} island(s) left out of the layout not carved back: the smoothing left cells next to them non-convex",
-            dropped.len()
+            "the {} island(s) left out of the layout not carved back: after {} attempts the smoothing still left cells next to carved islands non-convex, or their rings crossed the meshed region's boundary",
+            dropped.len(),
+            CARVE_ATTEMPTS + 1
         );
         Ok((None, note))
     }
@@ -182,7 +183,7 @@ fn with_rings(simplified: &Region, c: &crate::carve::Carved) -> Result<Region, V
 /// `; N not carved (a: reason, …)` for the islands skipped, or empty.
 fn skip_summary(outcomes: &[(usize, CarveOutcome)], left_out: usize, invalid: usize) -> String {
     let reasons = [
-        CarveSkip::BelowHalfCell,
+        CarveSkip::BelowMinArea,
         CarveSkip::OutsideMesh,
         CarveSkip::NotCompact,
         CarveSkip::TouchesBoundary,

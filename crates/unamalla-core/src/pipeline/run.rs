@@ -40,6 +40,39 @@ impl Mesher {
         }
     }
 
+    /// Leaves the holes narrower than `width` ([`unamalla_contour::hole_width`]) out of the
+    /// block layout of the next runs (the pipeline's own hole filter, whose holes are carved
+    /// back where carving is on) and forgets the layouts excluded by earlier fallbacks.
+    fn leave_out_holes_narrower(&mut self, width: f64) {
+        if let Some(o) = self.simplify.as_mut() {
+            o.holes = HoleFilter::MinWidth(width);
+        }
+        self.auto_dropped = true;
+        self.excluded_layouts.clear();
+    }
+
+    /// One more whole run with the current options, verified and taken through the layout
+    /// fallback ([`Mesher::layout_fallback`], whose notes go to `notes`); the error of a stage
+    /// that failed.
+    #[allow(clippy::type_complexity)]
+    fn remake_with_fallback(
+        &mut self,
+        region: &Region,
+        observer: &mut dyn Observer,
+        verify: &dyn Fn(&MeshResult) -> crate::verify::Verification,
+        notes: &mut Vec<String>,
+    ) -> Result<
+        (
+            (MeshResult, crate::verify::Verification),
+            (Option<String>, usize),
+        ),
+        CoreError,
+    > {
+        let retry = self.mesh_unverified(region, observer)?;
+        let rv = verify(&retry);
+        Ok(self.layout_fallback(region, observer, verify, (retry, rv), notes))
+    }
+
     /// Pipeline steps 1 and 1b alone: the region simplified by the contour method
     /// ([`simplify_for_mesh`]) and then without the boundary features below the cell size
     /// ([`Mesher::feature_factor`]). The mesher meshes [`PreparedRegion::mesh_region`]; a
@@ -153,17 +186,10 @@ impl Mesher {
         let mut carved_from_start = 0;
         if self.carve_dropped && self.drop_narrow_holes && self.carve_width > 0.0 && h > 0.0 {
             let width = self.carve_width * h;
-            if let Some(o) = self.simplify.as_mut() {
-                let narrow = region
-                    .holes()
-                    .iter()
-                    .filter(|hole| unamalla_contour::hole_width(hole) < width)
-                    .count();
-                if o.holes == HoleFilter::KeepAll && narrow > 0 {
-                    o.holes = HoleFilter::MinWidth(width);
-                    self.auto_dropped = true;
-                    carved_from_start = narrow;
-                }
+            let narrow = holes_narrower(region, width);
+            if self.auto_drop_width() == Some(0.0) && narrow > 0 {
+                self.leave_out_holes_narrower(width);
+                carved_from_start = narrow;
             }
         }
         if self.simplify.is_none() && self.decomposition.is_none() {
@@ -215,10 +241,9 @@ impl Mesher {
             }
             self.auto_dropped = false;
             self.excluded_layouts.clear();
-            if let Ok(retry) = self.mesh_unverified(region, observer) {
-                let rv = verify(&retry);
-                let ((retry, rv), retry_last) =
-                    self.layout_fallback(region, observer, &verify, (retry, rv), &mut failed);
+            if let Ok(((retry, rv), retry_last)) =
+                self.remake_with_fallback(region, observer, &verify, &mut failed)
+            {
                 if rv.passed() || bad_cells(&rv) < bad_cells(&v) {
                     result = retry;
                     v = rv;
@@ -230,11 +255,7 @@ impl Mesher {
         // hole is meshed again without every hole narrower than h ([`Mesher::drop_narrow_holes`])
         if !allow && !v.passed() && self.drop_narrow_holes && h > 0.0 {
             let default_filter = self.auto_drop_width().is_some();
-            let narrow = region
-                .holes()
-                .iter()
-                .filter(|hole| unamalla_contour::hole_width(hole) < h)
-                .count();
+            let narrow = holes_narrower(region, h);
             if default_filter && narrow > 0 && preflight::small_hole(&v, region, h).is_some() {
                 // with carving, every hole at the cell scale (narrower than NEAR_HOLE_WIDTH · h)
                 // leaves the layout, which then has no blocks a cell or two thick, and is carved
@@ -244,11 +265,7 @@ impl Mesher {
                 } else {
                     h
                 };
-                let dropped = region
-                    .holes()
-                    .iter()
-                    .filter(|hole| unamalla_contour::hole_width(hole) < width)
-                    .count();
+                let dropped = holes_narrower(region, width);
                 let note = if self.carve_dropped {
                     format!(
                         "the mesh keeping every hole failed the guarantee next to a hole narrower than the cell size {h:.4e}; made again with the {dropped} hole(s) narrower than {NEAR_HOLE_WIDTH} cell sizes left out of the block layout and carved back into the mesh"
@@ -259,19 +276,18 @@ impl Mesher {
                     )
                 };
                 self.stage(Stage::Decompose, &note);
-                if let Some(o) = self.simplify.as_mut() {
-                    o.holes = HoleFilter::MinWidth(width);
-                }
-                self.auto_dropped = true;
-                self.excluded_layouts.clear();
+                self.leave_out_holes_narrower(width);
                 let mut notes = vec![note];
                 // round 0 without the holes narrower than a cell; each later round (at most
                 // NEAR_HOLE_ROUNDS) also without the holes narrower than NEAR_HOLE_WIDTH · h
                 // next to which the previous round failed
                 let mut width = width;
                 for round in 0..=NEAR_HOLE_ROUNDS {
-                    let retry = match self.mesh_unverified(region, observer) {
-                        Ok(retry) => retry,
+                    // the layout fallback once more, on the region without those holes
+                    let ((retry, rv), rv_last) = match self
+                        .remake_with_fallback(region, observer, &verify, &mut notes)
+                    {
+                        Ok(attempt) => attempt,
                         // with carving, a decomposition that finds no cuts around the holes
                         // left is made again with wider holes left out (up to CARVE_MAX_WIDTH)
                         Err(e) if self.carve_dropped && 2.0 * width <= CARVE_MAX_WIDTH * h => {
@@ -282,18 +298,11 @@ impl Mesher {
                             );
                             self.stage(Stage::Decompose, &note);
                             notes.push(note);
-                            if let Some(o) = self.simplify.as_mut() {
-                                o.holes = HoleFilter::MinWidth(width);
-                            }
-                            self.excluded_layouts.clear();
+                            self.leave_out_holes_narrower(width);
                             continue;
                         }
                         Err(_) => break,
                     };
-                    let rv = verify(&retry);
-                    // the layout fallback once more, on the region without those holes
-                    let ((retry, rv), rv_last) =
-                        self.layout_fallback(region, observer, &verify, (retry, rv), &mut notes);
                     if rv.passed() {
                         failed.append(&mut notes);
                         result = retry;
@@ -388,11 +397,7 @@ impl Mesher {
         {
             let mut width = NEAR_HOLE_WIDTH * h;
             while width <= CARVE_MAX_WIDTH * h {
-                let small = region
-                    .holes()
-                    .iter()
-                    .filter(|hole| unamalla_contour::hole_width(hole) < width)
-                    .count();
+                let small = holes_narrower(region, width);
                 if small == 0 {
                     break;
                 }
@@ -404,21 +409,9 @@ impl Mesher {
                 );
                 self.stage(Stage::Decompose, &note);
                 failed.push(note);
-                if let Some(o) = self.simplify.as_mut() {
-                    o.holes = HoleFilter::MinWidth(width);
-                }
-                self.auto_dropped = true;
-                self.excluded_layouts.clear();
-                match self.mesh_unverified(region, observer) {
-                    Ok(retry) => {
-                        let rv = verify(&retry);
-                        let ((retry, rv), _) = self.layout_fallback(
-                            region,
-                            observer,
-                            &verify,
-                            (retry, rv),
-                            &mut failed,
-                        );
+                self.leave_out_holes_narrower(width);
+                match self.remake_with_fallback(region, observer, &verify, &mut failed) {
+                    Ok(((retry, rv), _)) => {
                         let share = retry.report.mu_ge_0_8_percent;
                         let kept = rv.passed() && share > result.report.mu_ge_0_8_percent;
                         failed.push(format!(
@@ -966,6 +959,15 @@ fn layout_name(result: &MeshResult) -> Option<String> {
 
 /// The cells a layout fallback counts against an attempt: non-convex, or with the centroid
 /// outside the region.
+/// The number of holes of `region` narrower than `width` ([`unamalla_contour::hole_width`]).
+fn holes_narrower(region: &Region, width: f64) -> usize {
+    region
+        .holes()
+        .iter()
+        .filter(|hole| unamalla_contour::hole_width(hole) < width)
+        .count()
+}
+
 fn bad_cells(v: &crate::verify::Verification) -> usize {
     v.non_convex_cells + v.centroids_outside.unwrap_or(0)
 }
