@@ -97,7 +97,13 @@ impl<'o> Session<'o> {
         let mut a = vec![0.0; ne];
         let mut b = vec![0.0; ne];
         problem.element_measures(x, &mut a);
-        let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1.0) * 1e-3;
+        // relative to the coordinates' magnitude (no absolute floor: the session must not
+        // depend on the units of the mesh)
+        let scale = x
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE)
+            * 1e-3;
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
         let xp: Vec<f64> = x
             .iter()

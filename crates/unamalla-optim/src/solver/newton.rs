@@ -281,7 +281,8 @@ pub(super) fn truncated_newton<P: Variables + Gradient + Hessian + ElementMeasur
                     f_acc = ft;
                     break;
                 }
-                let xs = norm(xr).max(1.0);
+                // relative to ‖x‖ (no absolute floor: the stop must not depend on the units)
+                let xs = norm(xr).max(f64::MIN_POSITIVE);
                 if radius <= 1e-15 * xs || o.znorm_m == 0.0 {
                     break 'outer StopReason::TrustRadius;
                 }
