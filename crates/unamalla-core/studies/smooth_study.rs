@@ -21,6 +21,9 @@
 //! * `sigma1` — σ continuation: 30 iterations at σ = 1 (H_ω only, Winslow-type), then
 //!   (6.8) σ = 0.1 with the default stop rules;
 //! * `sigma05` — the same with a first stage at σ = 0.5;
+//! * `mg` — `default` with the smoothed-aggregation multigrid preconditioner
+//!   (`Preconditioner::Multigrid`) in the inner CG instead of block-Jacobi;
+//! * `cg20` / `cg80` — `default` with the inner CG capped at 20 or 80 iterations instead of 40;
 //! * `final02` / `final03` / `final05` — the default options with the final σ = 0.2, 0.3 or
 //!   0.5 instead of 0.1 (no coarse level).
 //!
@@ -65,6 +68,13 @@ fn candidates() -> Vec<(&'static str, SmoothOptions, usize)> {
     s05.sigma_continuation = vec![0.5];
     s05.continuation_iter = 30;
     let d = default_smooth_options();
+    let mut mg = d.clone();
+    mg.solver.preconditioner = unamalla_core::optim::Preconditioner::Multigrid;
+    let cg = |n: usize| {
+        let mut o = default_smooth_options();
+        o.solver.cg_max_iter = n;
+        o
+    };
     let final_sigma = |sigma: f64| {
         let mut o = default_smooth_options();
         o.functional = unamalla_core::optim::SmoothFunctional::block_smoothing(sigma);
@@ -95,6 +105,9 @@ fn candidates() -> Vec<(&'static str, SmoothOptions, usize)> {
         ("plateau", plateau, 0),
         ("sigma1", s1, 0),
         ("sigma05", s05, 0),
+        ("mg", mg, DEFAULT_COARSE_LEVELS),
+        ("cg20", cg(20), DEFAULT_COARSE_LEVELS),
+        ("cg80", cg(80), DEFAULT_COARSE_LEVELS),
     ];
     match std::env::var("UNAMALLA_STUDY") {
         Ok(sel) => {
