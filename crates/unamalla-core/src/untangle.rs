@@ -369,6 +369,14 @@ mod tests {
     use super::*;
     use unamalla_mesh::StructuredGrid2;
 
+    /// The `n × n` grid of the unit square as a `QuadMesh` (boundary fixed) and its cell width.
+    fn unit_square(n: usize) -> (QuadMesh, f64) {
+        let h = 1.0 / (n - 1) as f64;
+        let g = StructuredGrid2::from_fn(n, n, |i, j| DVec2::new(i as f64 * h, j as f64 * h))
+            .expect("grid");
+        (QuadMesh::from_grid(&g), h)
+    }
+
     /// A 21 × 21 unit-square grid (as a `QuadMesh`, boundary fixed) with interior nodes pushed
     /// across their neighbours in two separate spots: each pushed node moves by 1.5 cell widths,
     /// so the four cells around it fold. Two patches must untangle both spots, the boundary
@@ -376,10 +384,7 @@ mod tests {
     #[test]
     fn two_folds_are_untangled_by_local_patches() {
         let n = 21;
-        let h = 1.0 / (n - 1) as f64;
-        let g = StructuredGrid2::from_fn(n, n, |i, j| DVec2::new(i as f64 * h, j as f64 * h))
-            .expect("grid");
-        let mut mesh = QuadMesh::from_grid(&g);
+        let (mut mesh, h) = unit_square(n);
         let at = |i: usize, j: usize| j * n + i;
         mesh.nodes_mut()[at(5, 5)] += DVec2::new(1.5 * h, 1.5 * h);
         mesh.nodes_mut()[at(15, 14)] -= DVec2::new(1.5 * h, 0.0);
@@ -413,10 +418,7 @@ mod tests {
     #[test]
     fn patch_runs_ignore_the_callers_window_tests() {
         let n = 21;
-        let h = 1.0 / (n - 1) as f64;
-        let g = StructuredGrid2::from_fn(n, n, |i, j| DVec2::new(i as f64 * h, j as f64 * h))
-            .expect("grid");
-        let mut plain = QuadMesh::from_grid(&g);
+        let (mut plain, h) = unit_square(n);
         plain.nodes_mut()[5 * n + 5] += DVec2::new(1.5 * h, 1.5 * h);
         let mut ruled = plain.clone();
         let opts = SmoothOptions::default();
@@ -463,10 +465,7 @@ mod tests {
     #[test]
     fn many_folds_finish_within_the_work_bound_and_report_progress() {
         let n = 49;
-        let h = 1.0 / (n - 1) as f64;
-        let g = StructuredGrid2::from_fn(n, n, |i, j| DVec2::new(i as f64 * h, j as f64 * h))
-            .expect("grid");
-        let mut mesh = QuadMesh::from_grid(&g);
+        let (mut mesh, h) = unit_square(n);
         let spots: Vec<(usize, usize)> = (0..6)
             .flat_map(|a| (0..6).map(move |b| (4 + 8 * a, 4 + 8 * b)))
             .collect();

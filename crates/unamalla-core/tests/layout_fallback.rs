@@ -13,11 +13,17 @@ use unamalla_core::mesh::quality::non_convex_cells;
 use unamalla_core::pipeline::{choose_layout_excluding, Mesher, LAYOUT_ASPECTS, QUALITY_FALLBACKS};
 use unamalla_core::verify::{verify_quads, VerifyOptions};
 
-fn region(name: &str) -> unamalla_core::mesh::Region {
+/// `fixtures/FOLDER/NAME.geojson`, its largest part.
+fn fixture(folder: &str, name: &str) -> unamalla_core::mesh::Region {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/regions")
+        .join("../../fixtures")
+        .join(folder)
         .join(format!("{name}.geojson"));
     io::read_region_geojson(p, PartSelector::Largest).unwrap()
+}
+
+fn region(name: &str) -> unamalla_core::mesh::Region {
+    fixture("regions", name)
 }
 
 /// The independent check of the mesh against the region it was made of passes.
@@ -158,9 +164,7 @@ fn a_layout_below_the_quality_target_is_retried_and_the_best_share_kept() {
 fn a_failure_next_to_holes_narrower_than_a_cell_is_meshed_without_them() {
     use unamalla_core::preflight::PreflightError;
     use unamalla_core::CoreError;
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/synthetic/archipelago-100.geojson");
-    let reg = io::read_region_geojson(p, PartSelector::Largest).unwrap();
+    let reg = fixture("synthetic", "archipelago-100");
     let h = (reg.area() / 1_000.0).sqrt();
     let narrow: Vec<usize> = (0..reg.holes().len())
         .filter(|&k| unamalla_core::contour::hole_width(&reg.holes()[k]) < h)
@@ -210,9 +214,7 @@ fn a_failure_next_to_holes_narrower_than_a_cell_is_meshed_without_them() {
             cargo test --release -p unamalla-core --test layout_fallback -- --ignored"]
 fn a_sea_of_islands_one_or_two_cells_across_is_meshed() {
     use unamalla_core::pipeline::NEAR_HOLE_WIDTH;
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/synthetic/archipelago-500.geojson");
-    let reg = io::read_region_geojson(p, PartSelector::Largest).unwrap();
+    let reg = fixture("synthetic", "archipelago-500");
     let h = (reg.area() / 20_000.0).sqrt();
     let width = |k: usize| unamalla_core::contour::hole_width(&reg.holes()[k]);
     let narrow = (0..reg.holes().len()).filter(|&k| width(k) < h).count();
@@ -259,9 +261,7 @@ fn a_sea_of_islands_one_or_two_cells_across_is_meshed() {
             cargo test --release -p unamalla-core --test layout_fallback -- --ignored"]
 fn a_sea_of_islands_is_meshed_with_its_islands_carved() {
     use unamalla_core::carve::MIN_AREA_FRACTION;
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/synthetic/archipelago-500.geojson");
-    let reg = io::read_region_geojson(p, PartSelector::Largest).unwrap();
+    let reg = fixture("synthetic", "archipelago-500");
     let r = Mesher::new()
         .cells(20_000)
         .mesh(&reg)

@@ -51,6 +51,16 @@ impl Mesher {
         self.excluded_layouts.clear();
     }
 
+    /// The inverse of [`Mesher::leave_out_holes_narrower`]: every hole back in the block layout
+    /// of the next runs (the default hole filter), the excluded layouts forgotten.
+    fn keep_every_hole(&mut self) {
+        if let Some(o) = self.simplify.as_mut() {
+            o.holes = HoleFilter::KeepAll;
+        }
+        self.auto_dropped = false;
+        self.excluded_layouts.clear();
+    }
+
     /// One more whole run with the current options, verified and taken through the layout
     /// fallback ([`Mesher::layout_fallback`], whose notes go to `notes`); the error of a stage
     /// that failed.
@@ -238,11 +248,7 @@ impl Mesher {
             );
             self.stage(Stage::Decompose, &note);
             failed.push(note);
-            if let Some(o) = self.simplify.as_mut() {
-                o.holes = HoleFilter::KeepAll;
-            }
-            self.auto_dropped = false;
-            self.excluded_layouts.clear();
+            self.keep_every_hole();
             if let Ok(((retry, rv), retry_last)) =
                 self.remake_with_fallback(region, observer, &verify, &mut failed)
             {
@@ -379,13 +385,7 @@ impl Mesher {
             failed.push(format!(
                 "layout {} reached μ ≥ 0.8 on {share:.1} % ({})",
                 last.0.as_deref().unwrap_or("?"),
-                if !rv.passed() {
-                    "failed the guarantee: not kept"
-                } else if share > result.report.mu_ge_0_8_percent {
-                    "kept"
-                } else {
-                    "not better: not kept"
-                }
+                verdict(rv.passed(), share > result.report.mu_ge_0_8_percent)
             ));
             last_failed = !rv.passed();
             if rv.passed() && share > result.report.mu_ge_0_8_percent {
@@ -431,13 +431,7 @@ impl Mesher {
                         let kept = rv.passed() && share > result.report.mu_ge_0_8_percent;
                         failed.push(format!(
                             "with the islands carved: μ ≥ 0.8 on {share:.1} % ({})",
-                            if kept {
-                                "kept"
-                            } else if !rv.passed() {
-                                "failed the guarantee: not kept"
-                            } else {
-                                "not better: not kept"
-                            }
+                            verdict(rv.passed(), share > result.report.mu_ge_0_8_percent)
                         ));
                         if kept {
                             result = retry;
@@ -968,6 +962,15 @@ fn nearly_touching(region: &Region, rel: f64) -> bool {
 }
 
 /// The automatically chosen layout of a mesh (`None`: the layout was given).
+/// What became of a retry, for its note: kept when it passed the guarantee and is `better`.
+fn verdict(passed: bool, better: bool) -> &'static str {
+    match (passed, better) {
+        (false, _) => "failed the guarantee: not kept",
+        (true, true) => "kept",
+        (true, false) => "not better: not kept",
+    }
+}
+
 fn layout_name(result: &MeshResult) -> Option<String> {
     result.report.layout.as_ref().map(|c| c.layout.clone())
 }
